@@ -1,0 +1,1 @@
+"""Dataset preparation: CLOTH3D reader, synthetic garments, reference simulation, cache."""

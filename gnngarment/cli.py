@@ -1,0 +1,143 @@
+"""The ``gnngarment`` command.
+
+Every command turns bad input (missing file, broken mesh, bad config) into one clear
+line on stderr and exit code 2 — never a traceback.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+app = typer.Typer(help="Animate any garment mesh with one learned model.",
+                  no_args_is_help=True, add_completion=False)
+console = Console()
+errors = Console(stderr=True)
+
+
+
+@app.callback()
+def root() -> None:
+    """Animate any garment mesh with one learned model."""
+
+
+#: Exit code for bad input (usage errors share it, as in typer/click).
+BAD_INPUT = 2
+
+
+def fail(message: str) -> typer.Exit:
+    """Print ``message`` as an error and return the exit to raise."""
+    errors.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
+    return typer.Exit(BAD_INPUT)
+
+
+def _garment_config(config_path: Path | None, levels: int | None):
+    from gnngarment.config import ConfigError, load_config
+    from gnngarment.geometry.prepare import GarmentPreparationConfig
+    from gnngarment.paths import default_config
+
+    path = config_path or default_config("garment.yaml")
+    try:
+        if config_path is not None or path.is_file():
+            config = load_config(path, GarmentPreparationConfig)
+        else:
+            config = GarmentPreparationConfig()
+    except ConfigError as error:
+        raise fail(str(error)) from None
+    if levels is not None:
+        if levels < 0:
+            raise fail(f"--levels must be >= 0, got {levels}")
+        config.levels = levels
+    return config
+
+
+@app.command()
+def inspect(
+    garment_mesh: Annotated[Path, typer.Argument(help="OBJ, PLY, OFF, STL, glTF or GLB file.")],
+    levels: Annotated[int | None, typer.Option(help="Pooling levels (default: config).")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print everything as JSON.")] = False,
+    config: Annotated[Path | None, typer.Option(help="Garment YAML config.")] = None,
+) -> None:
+    """Validate a garment mesh and print its pooling hierarchy and style descriptor."""
+    from gnngarment.geometry.errors import MeshError
+    from gnngarment.geometry.mesh_io import load_mesh
+    from gnngarment.geometry.prepare import prepare_garment
+
+    settings = _garment_config(config, levels)
+    start = time.perf_counter()
+    try:
+        pos, faces = load_mesh(garment_mesh)
+        load_seconds = time.perf_counter() - start
+        prepared = prepare_garment(pos, faces, settings, source=str(garment_mesh))
+    except MeshError as error:
+        raise fail(str(error)) from None
+    seconds = {"load": load_seconds, **prepared.seconds}
+    hierarchy = prepared.hierarchy
+    # Each component's centre at every level, in that level's numbering.
+    centres = [level.centres.tolist() for level in hierarchy.levels]
+
+    if as_json:
+        result = {
+            "file": str(garment_mesh),
+            "vertices": len(pos), "faces": len(faces),
+            "components": prepared.report.num_components,
+            "findings": prepared.report.findings,
+            "levels": [
+                {"level": k, "vertices": n, "edges": e,
+                 **({"centres": centres[k]} if k < len(centres) else {}),
+                 **({"kept": hierarchy.levels[k - 1].kept.tolist()} if k > 0 else {})}
+                for k, (n, e) in enumerate(zip(hierarchy.vertex_counts(),
+                                               hierarchy.edge_counts(), strict=True))
+            ],
+            "descriptor": prepared.descriptor.tolist(),
+            "seconds": seconds,
+        }
+        print(json.dumps(result, indent=2))
+        return
+
+    console.print(f"[bold]{garment_mesh}[/]: {len(pos)} vertices, {len(faces)} faces, "
+                  f"{prepared.report.num_components} component(s)")
+    for finding in prepared.report.findings:
+        console.print(f"  [yellow]finding:[/] {finding}")
+    if not prepared.report.findings:
+        console.print("  [green]no findings[/]")
+    table = Table(title="pooling hierarchy (Algorithm 1)")
+    for column in ("level", "vertices", "edges", "component centres (level numbering)"):
+        table.add_column(column)
+    for k, (n, e) in enumerate(zip(hierarchy.vertex_counts(), hierarchy.edge_counts(),
+                                   strict=True)):
+        shown = centres[k] if k < len(centres) else []
+        text = ", ".join(map(str, shown[:8])) + (" ..." if len(shown) > 8 else "")
+        table.add_row(str(k), str(n), str(e), text or "-")
+    console.print(table)
+    descriptor = prepared.descriptor
+    console.print(f"style descriptor ({len(descriptor)} Nyström eigenvalues, largest first): "
+                  + " ".join(f"{v:.4g}" for v in descriptor[:8]) + " ...")
+    console.print("seconds: " + ", ".join(f"{k} {v:.3f}" for k, v in seconds.items()))
+
+
+def _register_optional_commands() -> None:
+    """Commands of other subpackages register themselves here."""
+    try:
+        from gnngarment.body.commands import register as register_body
+    except ImportError:  # the body subpackage is optional until it lands
+        return
+    register_body(app)
+
+
+_register_optional_commands()
+
+
+def main() -> None:
+    """Console-script entry point."""
+    app()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,34 @@
+"""Garment mesh geometry: pure numpy/scipy, imports nothing else of gnngarment.
+
+Public API (arrays in, arrays out; ``pos (N, 3)``, ``faces (F, 3)``, ``edge_index (2, E)``):
+"""
+
+from gnngarment.geometry.eccentricity import graph_centres, hop_distance
+from gnngarment.geometry.errors import MeshError
+from gnngarment.geometry.geodesics import farthest_point_sampling, geodesic_distances
+from gnngarment.geometry.graph import adjacency_matrix, connected_components, edge_index_from_faces
+from gnngarment.geometry.hierarchy import PoolHierarchy, PoolLevel, pool_hierarchy
+from gnngarment.geometry.joint_distances import joint_distances
+from gnngarment.geometry.mesh_io import load_mesh
+from gnngarment.geometry.normals import face_normals, vertex_normals
+from gnngarment.geometry.nystrom import nystrom_descriptor
+from gnngarment.geometry.pooling import PooledGraph, pool
+from gnngarment.geometry.prepare import GarmentPreparationConfig, PreparedGarment, prepare_garment
+from gnngarment.geometry.scale import mesh_scale, surface_area, vertex_areas
+from gnngarment.geometry.unpooling import unpooling_matrix
+from gnngarment.geometry.validation import (
+    MeshReport,
+    check_mesh,
+    remove_unreferenced_vertices,
+    validate_mesh,
+)
+
+__all__ = [
+    "GarmentPreparationConfig", "MeshError", "MeshReport", "PoolHierarchy", "PoolLevel",
+    "PooledGraph", "PreparedGarment", "adjacency_matrix", "check_mesh", "connected_components",
+    "edge_index_from_faces", "face_normals", "farthest_point_sampling", "geodesic_distances",
+    "graph_centres", "hop_distance", "joint_distances", "load_mesh", "mesh_scale",
+    "nystrom_descriptor", "pool", "pool_hierarchy", "prepare_garment",
+    "remove_unreferenced_vertices", "surface_area", "unpooling_matrix", "validate_mesh",
+    "vertex_areas", "vertex_normals",
+]

@@ -1,0 +1,59 @@
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from gnngarment.geometry.errors import MeshError
+from gnngarment.geometry.mesh_io import load_mesh
+from tests.meshes import interleave, random_disk
+
+
+@pytest.mark.parametrize("extension", [".obj", ".ply", ".off", ".stl", ".glb"])
+def test_round_trip_keeps_vertex_order(extension: str, tmp_path: Path) -> None:
+    # A relabelled mesh: any reordering or welding by the loader would show.
+    pos, faces = interleave(*random_disk(80, 2), seed=5)
+    path = tmp_path / f"garment{extension}"
+    trimesh.Trimesh(pos, faces, process=False).export(path)
+
+    loaded_pos, loaded_faces = load_mesh(path)
+
+    if extension == ".stl":  # STL stores triangle soups: 3 vertices per face
+        np.testing.assert_allclose(loaded_pos[loaded_faces], pos[faces], atol=1e-5)
+    else:
+        np.testing.assert_allclose(loaded_pos, pos, atol=1e-5)
+        np.testing.assert_array_equal(loaded_faces, faces)
+
+
+def test_obj_keeps_duplicate_and_unreferenced_vertices_and_splits_quads(tmp_path: Path) -> None:
+    path = tmp_path / "quad.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 0\nv 9 9 9\n"
+                    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                    "f 1/1 2/2 3/3 4/4\nf 2/2 5/1 3/3\n")
+    pos, faces = load_mesh(path)
+    assert pos.shape == (6, 3)  # vertex 5 duplicates vertex 1; vertex 6 unreferenced
+    assert faces.tolist() == [[0, 1, 2], [0, 2, 3], [1, 4, 2]]
+
+
+def test_missing_unknown_and_broken_files_name_the_file(tmp_path: Path) -> None:
+    with pytest.raises(MeshError, match="absent.obj: file not found"):
+        load_mesh(tmp_path / "absent.obj")
+    (tmp_path / "mesh.xyz").write_text("1 2 3\n")
+    with pytest.raises(MeshError, match=r"mesh.xyz: unknown mesh format"):
+        load_mesh(tmp_path / "mesh.xyz")
+    (tmp_path / "broken.glb").write_bytes(b"glTF\x02\x00\x00\x00garbage")
+    with pytest.raises(MeshError, match="broken.glb"):
+        load_mesh(tmp_path / "broken.glb")
+    (tmp_path / "bad.obj").write_text("v 0 0 0\nv 1 0\nf 1 2 3\n")
+    with pytest.raises(MeshError, match=r"bad.obj:2: vertex line"):
+        load_mesh(tmp_path / "bad.obj")
+    (tmp_path / "cloud.obj").write_text("v 0 0 0\nv 1 0 0\n")
+    with pytest.raises(MeshError, match="cloud.obj: the file holds no faces"):
+        load_mesh(tmp_path / "cloud.obj")
+    (tmp_path / "points.ply").write_text(
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+        "property float z\nend_header\n0 0 0\n1 1 1\n")
+    with pytest.raises(MeshError, match="points.ply"):
+        load_mesh(tmp_path / "points.ply")

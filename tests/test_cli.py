@@ -1,0 +1,66 @@
+"""The command line as a user runs it: real files, exit codes, no tracebacks."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import trimesh
+from typer.testing import CliRunner
+
+from gnngarment.cli import app
+from tests.meshes import random_disk, tube, union
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def two_piece(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    folder = tmp_path_factory.mktemp("garments")
+    pos, faces = union(tube(12, 16), random_disk(150, 3))
+    mesh = trimesh.Trimesh(pos, faces, process=False)
+    paths = {}
+    for extension in ("obj", "ply", "glb"):
+        paths[extension] = folder / f"two_piece.{extension}"
+        mesh.export(paths[extension])
+    return paths
+
+
+@pytest.mark.parametrize("extension", ["obj", "ply", "glb"])
+def test_inspect_prints_hierarchy_of_a_two_piece_garment(two_piece, extension: str) -> None:
+    result = runner.invoke(app, ["inspect", str(two_piece[extension])])
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())  # rich wraps lines at the terminal width
+    assert "2 component(s)" in text
+    assert "pooling hierarchy" in text and "style descriptor" in text
+
+
+def test_inspect_json_has_levels_kept_indices_and_descriptor(two_piece) -> None:
+    result = runner.invoke(app, ["inspect", str(two_piece["obj"]), "--levels", "3", "--json"])
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.output)
+    assert report["components"] == 2
+    assert [level["level"] for level in report["levels"]] == [0, 1, 2, 3]
+    assert len(report["levels"][1]["kept"]) == report["levels"][1]["vertices"]
+    assert len(report["levels"][0]["centres"]) == 2
+    assert len(report["descriptor"]) == 64
+    assert set(report["seconds"]) >= {"load", "hierarchy", "descriptor"}
+
+
+def test_bad_input_exits_2_with_a_message_and_no_traceback(tmp_path: Path) -> None:
+    broken = tmp_path / "broken.obj"
+    broken.write_text("v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n")
+    cases = [
+        ([str(tmp_path / "absent.obj")], "absent.obj: file not found"),
+        ([str(broken)], "NaN/inf"),
+        ([str(broken), "--levels", "-1"], "--levels must be >= 0"),
+    ]
+    bad_config = tmp_path / "garment.yaml"
+    bad_config.write_text("levles: 2\n")
+    cases.append(([str(broken), "--config", str(bad_config)], "levles"))
+    for arguments, message in cases:
+        result = runner.invoke(app, ["inspect", *arguments])
+        assert result.exit_code == 2, result.output
+        assert message in " ".join(result.output.split())
+        assert "Traceback" not in result.output
