@@ -43,6 +43,7 @@ import numpy as np
 
 from gnngarment.geometry.geodesics import farthest_point_sampling
 from gnngarment.geometry.graph import edge_index_from_faces
+from gnngarment.geometry.scale import vertex_areas
 
 __all__ = ["nystrom_descriptor"]
 
@@ -145,10 +146,8 @@ def _lumped_area_weights(pos: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray
     Shapes: pos (N, 3), faces (F, 3) -> weights (N,) summing to 1 (all zero if the
     total area is 0), total area in units of pos squared.
     """
-    a, b, c = pos[faces[:, 0]], pos[faces[:, 1]], pos[faces[:, 2]]
-    face_area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    total_area = float(face_area.sum())
-    weight = np.bincount(faces.ravel(), weights=np.repeat(face_area / 3.0, 3), minlength=len(pos))
+    weight = vertex_areas(pos, faces)
+    total_area = float(weight.sum())
     return (weight / total_area if total_area > 0 else weight), total_area
 
 

@@ -109,8 +109,8 @@ def check_mesh(pos: np.ndarray, faces: np.ndarray, source: str = "<mesh>") -> Me
         report.errors.append(f"{len(degenerate)} degenerate (zero-area or repeated-vertex) "
                              f"faces (faces {_index_list(degenerate)})")
 
-    sorted_faces = np.sort(faces, axis=1)
-    _, first, counts = np.unique(sorted_faces, axis=0, return_index=True, return_counts=True)
+    _, first, counts = np.unique(_row_keys(np.sort(faces, axis=1), len(pos)),
+                                 return_index=True, return_counts=True)
     if (counts > 1).any():
         duplicated_rows = np.flatnonzero(
             np.isin(np.arange(len(faces)), first, invert=True))
@@ -128,8 +128,10 @@ def check_mesh(pos: np.ndarray, faces: np.ndarray, source: str = "<mesh>") -> Me
 
     edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]),
                     axis=1)
-    unique_edges, edge_counts = np.unique(edges, axis=0, return_counts=True)
-    report.non_manifold_edges = unique_edges[edge_counts > 2]
+    edge_keys, edge_counts = np.unique(edges[:, 0] * len(pos) + edges[:, 1],
+                                       return_counts=True)
+    crowded = edge_keys[edge_counts > 2]
+    report.non_manifold_edges = np.stack([crowded // len(pos), crowded % len(pos)], axis=1)
     if len(report.non_manifold_edges):
         report.findings.append(f"{len(report.non_manifold_edges)} non-manifold edges "
                                "(shared by more than two faces)")
@@ -142,6 +144,14 @@ def check_mesh(pos: np.ndarray, faces: np.ndarray, source: str = "<mesh>") -> Me
         report.findings.append(f"{report.num_components} connected components (valid: each "
                                "is pooled on its own)")
     return report
+
+
+def _row_keys(rows: np.ndarray, base: int) -> np.ndarray:
+    """One integer per ``(R, 3)`` row, equal iff the rows are equal. Integer keys make
+    ``np.unique`` ~10x faster than ``axis=0``; fall back to the latter if they overflow."""
+    if base ** 3 < 2**62:
+        return (rows[:, 0] * base + rows[:, 1]) * base + rows[:, 2]
+    return np.unique(rows, axis=0, return_inverse=True)[1].ravel()
 
 
 def validate_mesh(pos: np.ndarray, faces: np.ndarray, source: str = "<mesh>") -> MeshReport:
