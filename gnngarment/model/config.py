@@ -1,0 +1,83 @@
+"""Settings of the garment deformer (defaults mirror ``configs/model/paper.yaml``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+#: Pooling methods of the multilevel processor: the blueprint's structure-preserving
+#: pooling, or PyG's learned poolers (the paper's baselines).
+POOLING_METHODS = ("structure", "topk", "sag", "asap")
+
+
+@dataclass
+class ModelConfig:
+    """Widths and variants of :class:`~gnngarment.model.deformer.GarmentDeformer`.
+
+    Attributes:
+        garment_channels: per-head output channels of every E^gg GAT block; the style
+            cues multiply the features before the last block. The last entry is ``F``.
+        style_channels: E^gs MLP widths (last = ``F``).
+        body_channels: E^bs MLP widths (last = ``F``).
+        motion_hidden: E^t1 LSTM hidden size (= ``F``).
+        motion_layers: layers of both LSTMs.
+        processor_channels: channels of every M^mp GAT but the output one.
+        processor_heads: heads of the M^mp GATs (averaged).
+        output_heads: heads of the output GAT (3 channels, averaged).
+        levels: pooling levels of M^mp (0 = single level; 2 is the blueprint's best).
+        pooling: one of :data:`POOLING_METHODS`.
+        pooling_ratio: kept fraction for the learned PyG poolers.
+        physics_submodule: include the second M^mp trained by the physics stage.
+        landmarks: ``N*``, length of the Nyström descriptor (E^gs input).
+        body_vertices: ``N_b'``, size of the body-vertex subset (E^bs input, E^t2 input/3).
+        window: ``m``, frames of motion history seen by the LSTMs.
+        dropout: attention dropout of the GATs (0 = none).
+    """
+
+    garment_channels: list[int] = field(default_factory=lambda: [32, 64, 128, 128])
+    style_channels: list[int] = field(default_factory=lambda: [256, 256, 128])
+    body_channels: list[int] = field(default_factory=lambda: [512, 256, 128])
+    motion_hidden: int = 128
+    motion_layers: int = 2
+    processor_channels: int = 32
+    processor_heads: int = 4
+    output_heads: int = 4
+    levels: int = 2
+    pooling: str = "structure"
+    pooling_ratio: float = 0.5
+    physics_submodule: bool = True
+    landmarks: int = 64
+    body_vertices: int = 512
+    window: int = 5
+    dropout: float = 0.0
+
+    @property
+    def feature_channels(self) -> int:
+        """``F``: per-joint width of the fused garment–body features."""
+        return self.garment_channels[-1]
+
+    def validate(self) -> None:
+        """Raise ``ValueError`` for inconsistent settings (naming the field)."""
+        width = self.feature_channels
+        if len(self.garment_channels) < 2 or min(self.garment_channels) < 1:
+            raise ValueError("garment_channels needs >= 2 positive widths (the style cues "
+                             f"multiply the input of the last block), got {self.garment_channels}")
+        if self.garment_channels[-2] != width:
+            raise ValueError("garment_channels[-2] must equal F = garment_channels[-1] (the "
+                             f"style cues have F channels), got {self.garment_channels}")
+        for name in ("style_channels", "body_channels"):
+            channels = getattr(self, name)
+            if not channels or channels[-1] != width:
+                raise ValueError(f"{name} must end with F = garment_channels[-1] = {width}, "
+                                 f"got {channels}")
+        if self.motion_hidden != width:
+            raise ValueError(f"motion_hidden must equal F = {width}, got {self.motion_hidden}")
+        if self.pooling not in POOLING_METHODS:
+            raise ValueError(f"pooling must be one of {POOLING_METHODS}, got '{self.pooling}'")
+        if not 0 <= self.levels <= 6:
+            raise ValueError(f"levels must be in 0..6, got {self.levels}")
+        if not 0 < self.pooling_ratio < 1:
+            raise ValueError(f"pooling_ratio must be in (0, 1), got {self.pooling_ratio}")
+        for name in ("motion_layers", "processor_channels", "processor_heads", "output_heads",
+                     "landmarks", "body_vertices", "window"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")

@@ -1,0 +1,268 @@
+"""The full garment deformer of the blueprint (Fig. 2): encoders, fusion, skinning
+weights, multilevel blend shapes and linear blend skinning.
+
+The work is split as the blueprint prescribes: :meth:`GarmentDeformer.prepare` runs
+the per garment–body pair part once (E^gg, E^gs, E^bs → ``X^fuse``);
+:meth:`GarmentDeformer.forward` runs the per-frame part (E^t1, E^t2, M^mp, LBS) for any
+number of frames against that context.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import torch
+from torch import nn
+
+from gnngarment.body.skeleton import NUM_JOINTS
+from gnngarment.body.skinning import skin
+from gnngarment.geometry.hierarchy import PoolHierarchy
+from gnngarment.model.body_shape_encoder import BodyShapeEncoder
+from gnngarment.model.config import ModelConfig
+from gnngarment.model.garment_encoder import GarmentGraphEncoder
+from gnngarment.model.graph_levels import GraphLevels, stack_hierarchies
+from gnngarment.model.motion_encoder import MotionEncoder
+from gnngarment.model.multilevel_processor import MultilevelProcessor
+from gnngarment.model.style_encoder import StyleEncoder
+from gnngarment.model.vertex_features import VERTEX_FEATURE_CHANNELS
+
+#: Per-frame motion state: 24 axis-angles + root displacement (blueprint Eq. 6).
+MOTION_CHANNELS = 3 * (NUM_JOINTS + 1)
+
+
+@dataclass
+class GarmentBodyPair:
+    """Model inputs of one garment on one body (tensors; built by the data layer).
+
+    Attributes:
+        rest_pos: ``(N, 3)`` garment rest positions on the rest body (metres).
+        features: ``(N, 30)`` vertex features (:func:`garment_vertex_features`).
+        hierarchy: the garment's pooling hierarchy (topology only).
+        descriptor: ``(N*,)`` Nyström style descriptor.
+        body_distances: ``(N_b', 24)`` body-shape feature ``D``.
+    """
+
+    rest_pos: torch.Tensor
+    features: torch.Tensor
+    hierarchy: PoolHierarchy
+    descriptor: torch.Tensor
+    body_distances: torch.Tensor
+
+
+@dataclass
+class DeformerContext:
+    """Per-pair results of :meth:`GarmentDeformer.prepare`, reused for every frame.
+
+    Attributes:
+        fused: ``(ΣN, S, F)`` ``X^fuse`` of all pairs, concatenated along vertices.
+        rest_pos: ``(ΣN, 3)``.
+        ptr: ``(P + 1,)`` vertex offsets of the pairs.
+        hierarchies: one per pair.
+    """
+
+    fused: torch.Tensor
+    rest_pos: torch.Tensor
+    ptr: list[int]
+    hierarchies: list[PoolHierarchy]
+    _graphs: dict[int, GraphLevels] = field(default_factory=dict, repr=False)
+
+    @property
+    def num_pairs(self) -> int:
+        return len(self.hierarchies)
+
+
+@dataclass
+class DeformerOutput:
+    """Per-frame outputs for ``P`` pairs × ``B`` frames, concatenated item by item
+    (item ``k = p·B + b`` holds pair ``p``'s ``N_p`` vertices at frame ``b``).
+
+    Attributes:
+        weights: ``(V, 24)`` skinning weights ``W^t`` (rows sum to 1).
+        blend_shapes: ``(V, 3)`` ``B^t`` (metres, rest frame).
+        supervised_blend_shapes: ``(V, 3)`` the supervised submodule's part of ``B^t``.
+        posed: ``(V, 3)`` ``M^t`` (metres, world).
+        item: ``(V,)`` item index of every vertex.
+        item_ptr: ``(P·B + 1,)`` vertex offsets of the items.
+    """
+
+    weights: torch.Tensor
+    blend_shapes: torch.Tensor
+    supervised_blend_shapes: torch.Tensor
+    posed: torch.Tensor
+    item: torch.Tensor
+    item_ptr: torch.Tensor
+
+    def split(self, name: str, pair_sizes: Sequence[int], frames: int) -> list[torch.Tensor]:
+        """One ``(B, N_p, C)`` tensor per pair for the output field ``name``."""
+        tensor = getattr(self, name)
+        pieces, start = [], 0
+        for size in pair_sizes:
+            pieces.append(tensor[start:start + size * frames].view(frames, size, -1))
+            start += size * frames
+        return pieces
+
+
+class GarmentDeformer(nn.Module):
+    """Skinning weights and blend shapes for any garment on any body and motion.
+
+    Args:
+        config: widths and variants (:class:`ModelConfig`).
+    """
+
+    def __init__(self, config: ModelConfig):
+        super().__init__()
+        config.validate()
+        self.config = config
+        width = config.feature_channels
+        self.garment_encoder = GarmentGraphEncoder(VERTEX_FEATURE_CHANNELS,
+                                                   list(config.garment_channels), NUM_JOINTS,
+                                                   config.dropout)
+        self.style_encoder = StyleEncoder(config.landmarks, list(config.style_channels))
+        self.body_encoder = BodyShapeEncoder(config.body_vertices, list(config.body_channels))
+        self.pose_encoder = MotionEncoder(MOTION_CHANNELS, config.motion_hidden,
+                                          config.motion_layers)
+        self.velocity_encoder = MotionEncoder(3 * config.body_vertices, width * NUM_JOINTS,
+                                              config.motion_layers)
+
+        def processor() -> MultilevelProcessor:
+            return MultilevelProcessor(width * NUM_JOINTS, config.processor_channels,
+                                       config.processor_heads, 3, config.output_heads,
+                                       config.levels, config.pooling, config.pooling_ratio,
+                                       config.dropout)
+
+        self.supervised_processor = processor()
+        self.physics_processor = processor() if config.physics_submodule else None
+        if self.physics_processor is not None:
+            # The physics stage starts from the supervised solution: its submodule adds
+            # exactly zero until trained (output weights zero, inner layers as usual).
+            nn.init.zeros_(self.physics_processor.output.lin.weight)
+            nn.init.zeros_(self.physics_processor.output.bias)
+        #: Whether forward adds the physics submodule (off during the supervised stage).
+        self.use_physics = False
+
+    # ---------------------------------------------------------------- per pair
+    def prepare(self, pairs: Sequence[GarmentBodyPair]) -> DeformerContext:
+        """Encode garments and bodies once: ``X^fuse = X̂^gg ⊙ C^bs`` (Eq. 5).
+
+        Shapes: see :class:`GarmentBodyPair`; returns ``fused (ΣN, 24, F)``.
+        """
+        if not pairs:
+            raise ValueError("prepare() needs at least one garment-body pair")
+        sizes = [int(pair.rest_pos.shape[0]) for pair in pairs]
+        for index, pair in enumerate(pairs):
+            _check_pair(index, pair, self.config)
+        device = pairs[0].features.device
+        features = torch.cat([pair.features for pair in pairs])
+        edge_index = torch.cat([
+            torch.as_tensor(pair.hierarchy.edge_index, device=device) + offset
+            for pair, offset in zip(pairs, _offsets(sizes), strict=False)], dim=1)
+        pair_of_vertex = torch.repeat_interleave(torch.arange(len(pairs), device=device),
+                                                 torch.tensor(sizes, device=device))
+        style = self.style_encoder(torch.stack([pair.descriptor for pair in pairs]))
+        garment = self.garment_encoder(features, edge_index, style[pair_of_vertex])
+        body = self.body_encoder(torch.stack([pair.body_distances for pair in pairs]))
+        fused = garment * body[pair_of_vertex]
+        return DeformerContext(fused=fused, rest_pos=torch.cat([p.rest_pos for p in pairs]),
+                               ptr=_offsets(sizes), hierarchies=[p.hierarchy for p in pairs])
+
+    # ---------------------------------------------------------------- per frame
+    def forward(self, context: DeformerContext, motion_windows: torch.Tensor,
+                velocity_windows: torch.Tensor, joint_transforms: torch.Tensor
+                ) -> DeformerOutput:
+        """Deform every pair of ``context`` for ``B`` frames each.
+
+        Shapes:
+            motion_windows: ``(P, B, m, 75)`` joint axis-angles + root displacement.
+            velocity_windows: ``(P, B, m, 3 N_b')`` body-subset velocities (m/s).
+            joint_transforms: ``(P, B, 24, 4, 4)`` skinning transforms of the frames.
+
+        Returns:
+            :class:`DeformerOutput` with ``V = B · ΣN`` rows.
+        """
+        pairs, frames = context.num_pairs, motion_windows.shape[1]
+        _check_frames(motion_windows, velocity_windows, joint_transforms, pairs, self.config)
+        width = self.config.feature_channels
+        pose_code, _ = self.pose_encoder(motion_windows.flatten(0, 1))       # (P·B, F)
+        velocity_code, _ = self.velocity_encoder(velocity_windows.flatten(0, 1))  # (P·B, S·F)
+        pose_code = pose_code.view(pairs, frames, width)
+        velocity_code = velocity_code.view(pairs, frames, NUM_JOINTS * width)
+
+        weights, processor_input = [], []
+        for p in range(pairs):
+            fused = context.fused[context.ptr[p]:context.ptr[p + 1]]           # (N, S, F)
+            logits = torch.einsum("nsf,bf->bns", fused, pose_code[p])          # Eq. 6
+            weights.append(torch.softmax(logits, dim=-1).flatten(0, 1))
+            processor_input.append(
+                (fused.flatten(1)[None] * velocity_code[p][:, None, :]).flatten(0, 1))  # Eq. 7
+        weights_all = torch.cat(weights)
+        x = torch.cat(processor_input)
+
+        graph = self._graph_levels(context, frames, x.device)
+        supervised = self.supervised_processor(x, graph)                       # Eq. 8
+        blend = supervised
+        if self.use_physics and self.physics_processor is not None:
+            blend = supervised + self.physics_processor(x, graph)
+
+        sizes = [context.ptr[p + 1] - context.ptr[p] for p in range(pairs)]
+        rest = torch.cat([context.rest_pos[context.ptr[p]:context.ptr[p + 1]].repeat(frames, 1)
+                          for p in range(pairs)])
+        item_sizes = torch.tensor([s for s in sizes for _ in range(frames)], device=x.device)
+        item = torch.repeat_interleave(torch.arange(pairs * frames, device=x.device), item_sizes)
+        posed = skin(rest, blend, weights_all, joint_transforms.flatten(0, 1), batch=item)
+        item_ptr = torch.cat([item_sizes.new_zeros(1), torch.cumsum(item_sizes, 0)])
+        return DeformerOutput(weights=weights_all, blend_shapes=blend,
+                              supervised_blend_shapes=supervised, posed=posed, item=item,
+                              item_ptr=item_ptr)
+
+    def _graph_levels(self, context: DeformerContext, frames: int,
+                      device: torch.device) -> GraphLevels:
+        # Index structures depend only on topology and B: build once per context and B.
+        if frames not in context._graphs:
+            hierarchies = [h for h in context.hierarchies for _ in range(frames)]
+            levels = self.config.levels if self.config.pooling == "structure" else 0
+            graph = stack_hierarchies(hierarchies, levels)
+            graph.edge_index = [e.to(device) for e in graph.edge_index]
+            graph.batch = [b.to(device) for b in graph.batch]
+            graph.kept = [k.to(device) for k in graph.kept]
+            graph.unpool = [u.to(device) for u in graph.unpool]
+            context._graphs[frames] = graph
+        return context._graphs[frames]
+
+
+def _offsets(sizes: Sequence[int]) -> list[int]:
+    offsets = [0]
+    for size in sizes:
+        offsets.append(offsets[-1] + size)
+    return offsets
+
+
+def _check_pair(index: int, pair: GarmentBodyPair, config: ModelConfig) -> None:
+    n = pair.rest_pos.shape[0]
+    expected = {
+        "rest_pos": (n, 3), "features": (n, VERTEX_FEATURE_CHANNELS),
+        "descriptor": (config.landmarks,), "body_distances": (config.body_vertices, NUM_JOINTS),
+    }
+    for name, shape in expected.items():
+        actual = tuple(getattr(pair, name).shape)
+        if actual != shape:
+            raise ValueError(f"pair {index}: {name} has shape {actual}, expected {shape}")
+        if not torch.isfinite(getattr(pair, name)).all():
+            raise ValueError(f"pair {index}: {name} contains NaN or inf")
+    if pair.hierarchy.num_vertices != n:
+        raise ValueError(f"pair {index}: hierarchy has {pair.hierarchy.num_vertices} vertices, "
+                         f"garment has {n}")
+
+
+def _check_frames(motion: torch.Tensor, velocity: torch.Tensor, transforms: torch.Tensor,
+                  pairs: int, config: ModelConfig) -> None:
+    if motion.dim() != 4 or motion.shape[0] != pairs or motion.shape[-1] != MOTION_CHANNELS:
+        raise ValueError(f"motion_windows must be (P={pairs}, B, m, {MOTION_CHANNELS}), "
+                         f"got {tuple(motion.shape)}")
+    frames, window = motion.shape[1], motion.shape[2]
+    if tuple(velocity.shape) != (pairs, frames, window, 3 * config.body_vertices):
+        raise ValueError(f"velocity_windows must be ({pairs}, {frames}, {window}, "
+                         f"{3 * config.body_vertices}), got {tuple(velocity.shape)}")
+    if tuple(transforms.shape) != (pairs, frames, NUM_JOINTS, 4, 4):
+        raise ValueError(f"joint_transforms must be ({pairs}, {frames}, {NUM_JOINTS}, 4, 4), "
+                         f"got {tuple(transforms.shape)}")
