@@ -1,0 +1,124 @@
+"""``gnngarment body`` and ``gnngarment motions`` (registered on the main Typer app)."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+
+
+def _fail(message: str) -> None:
+    from rich.console import Console
+
+    Console(stderr=True).print(f"[bold red]error:[/] {message}", highlight=False)
+    raise typer.Exit(2)
+
+
+def write_obj_sequence(
+    out: Path, vertices: np.ndarray, faces: np.ndarray, stem: str = "body", progress=None
+) -> list[Path]:
+    """One OBJ per frame, ``out/<stem>_0000.obj`` …
+
+    Shapes:
+        vertices ``(T, N, 3)``, faces ``(F, 3)`` (0-based).
+    """
+    # One %-format over the whole frame is ~3× faster than numpy.savetxt.
+    face_block = ("f %d %d %d\n" * len(faces)) % tuple((faces + 1).ravel().tolist())
+    vertex_format = "v %.5f %.5f %.5f\n" * vertices.shape[1]
+    paths = []
+    for t, frame in enumerate(vertices):
+        path = out / f"{stem}_{t:04d}.obj"
+        path.write_text(vertex_format % tuple(frame.ravel().tolist()) + face_block)
+        paths.append(path)
+        if progress is not None:
+            progress()
+    return paths
+
+
+def body_command(
+    out: Annotated[Path, typer.Option("--out", help="Output folder (created).")],
+    motion: Annotated[
+        str, typer.Option("--motion", help="Procedural motion name or .npz/.bvh/.mat file.")
+    ] = "walk",
+    shape: Annotated[
+        str | None,
+        typer.Option("--shape", help="Anny preset or .json/.yaml phenotype file; SMPL betas file."),
+    ] = None,
+    model: Annotated[str, typer.Option("--model", help="Body model: anny or smpl.")] = "anny",
+    smpl_path: Annotated[
+        str, typer.Option("--smpl-path", help="SMPL .pkl/.npz (with --model smpl).")
+    ] = "",
+    fps: Annotated[float, typer.Option("--fps", help="Output frame rate.")] = 30.0,
+    duration: Annotated[
+        float, typer.Option("--duration", help="Seconds (procedural motions).")
+    ] = 4.0,
+    seed: Annotated[
+        int | None, typer.Option("--seed", help="Seeded variation of procedural motions.")
+    ] = None,
+) -> None:
+    """Pose a body by a motion: OBJ sequence + skeleton preview PNG in --out."""
+    from rich.console import Console
+    from rich.progress import Progress
+
+    from gnngarment.body.config import BodyConfig
+    from gnngarment.body.factory import create_body_model
+    from gnngarment.body.motion import MotionError
+    from gnngarment.body.motion_io import load_motion
+    from gnngarment.body.preview import plot_motion_preview
+    from gnngarment.body.smpl_model import SMPLModelError
+
+    console = Console(stderr=True)
+    start = time.perf_counter()
+    if fps <= 0:
+        _fail(f"--fps must be > 0, got {fps}")
+    if duration <= 0:
+        _fail(f"--duration must be > 0, got {duration}")
+    if model not in ("anny", "smpl"):
+        _fail(f"--model must be 'anny' or 'smpl', got '{model}'")
+    try:
+        motion_data = load_motion(motion, fps=fps, duration=duration, seed=seed)
+    except MotionError as error:
+        _fail(str(error))
+    try:
+        with console.status(f"loading the {model} body model (first Anny run builds a cache)"):
+            body = create_body_model(BodyConfig(model=model, smpl_model_path=smpl_path))
+        body_shape = body.parse_shape(shape)
+    except (SMPLModelError, ValueError) as error:
+        _fail(str(error))
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        _fail(f"{out}: cannot create the output folder ({error})")
+    with console.status(f"posing {motion_data.num_frames} frames"):
+        posed = body.pose(motion_data, body_shape)
+    vertices = posed.vertices.numpy()
+    with Progress(console=console, transient=True) as progress:
+        task = progress.add_task("writing OBJ frames", total=len(vertices))
+        write_obj_sequence(out, vertices, body.faces, progress=lambda: progress.advance(task))
+    preview = plot_motion_preview(motion_data, body.rest(body_shape).joints, out / "skeleton.png")
+    console.print(
+        f"wrote {len(vertices)} frames ({vertices.shape[1]} vertices) to {out} and "
+        f"{preview.name} in {time.perf_counter() - start:.1f} s"
+    )
+
+
+def motions_command() -> None:
+    """List the procedural motion library."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from gnngarment.body.procedural import list_motions
+
+    table = Table("motion", "description", title="procedural motions")
+    for name, description in list_motions():
+        table.add_row(name, description)
+    Console().print(table)
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``body`` and ``motions`` commands to ``app``."""
+    app.command("body")(body_command)
+    app.command("motions")(motions_command)

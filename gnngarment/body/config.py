@@ -1,0 +1,41 @@
+"""Settings of the body package (defaults mirrored in ``configs/body.yaml``)."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+
+@dataclasses.dataclass
+class BodyConfig:
+    """Which body model to use and how body/motion features are built.
+
+    Attributes:
+        model: ``"anny"`` (default, ships with its wheel) or ``"smpl"`` (user file).
+        smpl_model_path: SMPL ``.pkl``/``.npz`` file (or folder of ``SMPL_<GENDER>.pkl``),
+            used when ``model == "smpl"``.
+        smpl_gender: ``neutral``, ``male`` or ``female`` (picks the file in a folder).
+        anny_rest_pose: ``"tpose"`` (the canonical rest pose, arms along ±X) or
+            ``"native"`` (Anny's own A-pose; mocap meant for a T-pose then looks wrong).
+        feature_vertex_count: size N_b′ of the farthest-point body-vertex subset used
+            for D and for body-vertex velocities.
+        motion_window: m, frames per temporal-encoder window (the paper gives no value).
+        fps: frame rate motions are resampled to before posing.
+    """
+
+    model: str = "anny"
+    smpl_model_path: str = ""
+    smpl_gender: str = "neutral"
+    anny_rest_pose: str = "tpose"
+    feature_vertex_count: int = 512
+    motion_window: int = 10
+    fps: float = 30.0
+
+
+def load_body_config(path: str | Path | None = None) -> BodyConfig:
+    """``configs/body.yaml`` (or ``path``) merged strictly onto :class:`BodyConfig`."""
+    from gnngarment.config import load_config
+
+    if path is None:
+        return BodyConfig()
+    return load_config(path, BodyConfig)

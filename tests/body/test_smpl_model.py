@@ -1,0 +1,114 @@
+"""SMPL through smplx's loader, on a small synthetic model written in the SMPL format."""
+
+import pickle
+
+import numpy as np
+import pytest
+import torch
+
+from gnngarment.body.motion import Motion
+from gnngarment.body.motion_io import SMPL_TO_CANONICAL
+from gnngarment.body.skeleton import JOINT_INDEX, JOINT_PARENTS
+from gnngarment.body.skinning import skin
+from gnngarment.body.smpl_model import SMPLBodyModel, SMPLModelError
+
+
+def _synthetic_smpl(n_per_joint=4, seed=0):
+    """A tiny SMPL-format model: a Y-up stick figure with a few vertices per joint."""
+    rng = np.random.default_rng(seed)
+    joints = np.zeros((24, 3))
+    offsets = {  # child offset from parent, metres, Y up, facing +Z, left = +X
+        1: (0.09, -0.08, 0), 2: (-0.09, -0.08, 0), 3: (0, 0.1, 0), 4: (0, -0.38, 0),
+        5: (0, -0.38, 0), 6: (0, 0.13, 0), 7: (0, -0.4, 0), 8: (0, -0.4, 0), 9: (0, 0.05, 0),
+        10: (0, -0.05, 0.12), 11: (0, -0.05, 0.12), 12: (0, 0.22, 0), 13: (0.08, 0.12, 0),
+        14: (-0.08, 0.12, 0), 15: (0, 0.09, 0), 16: (0.1, 0.02, 0), 17: (-0.1, 0.02, 0),
+        18: (0.26, 0, 0), 19: (-0.26, 0, 0), 20: (0.25, 0, 0), 21: (-0.25, 0, 0),
+        22: (0.08, 0, 0), 23: (-0.08, 0, 0),
+    }  # fmt: skip
+    for j in range(1, 24):
+        joints[j] = joints[JOINT_PARENTS[j]] + offsets[j]
+    vertices = np.repeat(joints, n_per_joint, axis=0) + 0.02 * rng.standard_normal(
+        (24 * n_per_joint, 3)
+    )
+    n = len(vertices)
+    owner = np.repeat(np.arange(24), n_per_joint)
+    weights = np.zeros((n, 24))
+    weights[np.arange(n), owner] = 1.0
+    regressor = np.zeros((24, n))
+    regressor[owner, np.arange(n)] = 1.0 / n_per_joint
+    # Joint = mean of its vertices; shift vertices so that mean lands exactly on the joint.
+    for j in range(24):
+        vertices[owner == j] += joints[j] - vertices[owner == j].mean(0)
+    faces = np.array([[i, i + 1, i + 2] for i in range(0, n - 2, 3)], dtype=np.int64)
+    kintree = np.array(
+        [[4294967295 if p < 0 else p for p in JOINT_PARENTS], list(range(24))], dtype=np.int64
+    )
+    return {
+        "v_template": vertices,
+        "shapedirs": 0.01 * rng.standard_normal((n, 3, 10)),
+        "posedirs": np.zeros((n, 3, 207)),
+        "J_regressor": regressor,
+        "weights": weights,
+        "kintree_table": kintree,
+        "f": faces,
+    }
+
+
+@pytest.fixture(scope="module", params=["pkl", "npz"])
+def smpl_file(tmp_path_factory, request):
+    path = tmp_path_factory.mktemp("smpl") / f"SMPL_NEUTRAL.{request.param}"
+    data = _synthetic_smpl()
+    if request.param == "pkl":
+        with open(path, "wb") as f:
+            pickle.dump(data, f)
+    else:
+        np.savez(path, **data)
+    return path
+
+
+def test_rest_is_z_up(smpl_file):
+    body = SMPLBodyModel(smpl_file)
+    data = _synthetic_smpl()
+    rest = body.rest()
+    assert torch.allclose(
+        rest.vertices.double(), torch.tensor(data["v_template"] @ SMPL_TO_CANONICAL.T), atol=1e-6
+    )
+    assert (
+        rest.joints[JOINT_INDEX["head"], 2]
+        > rest.joints[0, 2]
+        > rest.joints[JOINT_INDEX["L_knee"], 2]
+    )
+    assert rest.faces.shape[1] == 3
+    betas = body.parse_shape([1.0, -1.0])
+    assert betas.shape == (10,) and not torch.allclose(body.rest(betas).vertices, rest.vertices)
+
+
+def test_folder_lookup(smpl_file):
+    assert SMPLBodyModel(smpl_file.parent).path.name.startswith("SMPL_NEUTRAL")
+
+
+def test_pose_matches_joint_transforms(smpl_file):
+    body = SMPLBodyModel(smpl_file)
+    rng = np.random.default_rng(2)
+    motion = Motion(0.4 * rng.standard_normal((3, 24, 3)), rng.standard_normal((3, 3)), 30.0)
+    betas = body.parse_shape([0.5] * 10)
+    posed = body.pose(motion, betas)
+    assert torch.allclose(
+        body.pose(Motion.rest(1), betas).vertices[0], body.rest(betas).vertices, atol=1e-5
+    )
+    # No pose correctives in the synthetic model and one-hot weights: every vertex follows its
+    # joint's transform exactly, i.e. garment LBS with the transforms equals the body.
+    data = _synthetic_smpl()
+    weights = torch.tensor(data["weights"], dtype=torch.float32)
+    skinned = skin(body.rest(betas).vertices, None, weights, posed.joint_transforms)
+    assert (skinned - posed.vertices).abs().max() < 1e-5
+
+
+def test_missing_file_says_where_to_get_it(tmp_path):
+    with pytest.raises(SMPLModelError, match=r"smpl\.is\.tue\.mpg\.de"):
+        SMPLBodyModel(tmp_path / "SMPL_MALE.pkl")
+    with pytest.raises(SMPLModelError, match="SMPL_FEMALE"):
+        SMPLBodyModel(tmp_path, gender="female")
+    (tmp_path / "broken.pkl").write_bytes(b"not a pickle")
+    with pytest.raises(SMPLModelError, match="broken.pkl"):
+        SMPLBodyModel(tmp_path / "broken.pkl")
