@@ -3,14 +3,13 @@ Algorithm 2 unpooling matrix of every step, computed once per topology and cache
 
 from __future__ import annotations
 
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sp
 
+from gnngarment.geometry.files import load_npz, save_npz_atomic
 from gnngarment.geometry.pooling import pool
 from gnngarment.geometry.unpooling import unpooling_matrix
 
@@ -88,15 +87,7 @@ class PoolHierarchy:
                 f"level{k}_unpool_indptr": unpool.indptr,
                 f"level{k}_unpool_shape": np.array(unpool.shape),
             }
-        path.parent.mkdir(parents=True, exist_ok=True)
-        handle, temporary = tempfile.mkstemp(prefix=path.name, suffix=".tmp", dir=path.parent)
-        try:
-            with os.fdopen(handle, "wb") as stream:
-                np.savez(stream, **arrays)
-            os.replace(temporary, path)
-        except BaseException:
-            Path(temporary).unlink(missing_ok=True)
-            raise
+        save_npz_atomic(path, arrays)
 
     @classmethod
     def load(cls, path: str | Path) -> PoolHierarchy:
@@ -107,33 +98,26 @@ class PoolHierarchy:
                 the message names the file.
         """
         path = Path(path)
-        if not path.is_file():
-            raise ValueError(f"{path}: hierarchy file not found")
+        data = load_npz(path, required=("format_version", "num_vertices", "depth",
+                                        "edge_index"))
+        version = int(data["format_version"])
+        if version != HIERARCHY_FORMAT_VERSION:
+            raise ValueError(f"{path}: hierarchy format version {version}, expected "
+                             f"{HIERARCHY_FORMAT_VERSION}; rebuild it")
         try:
-            with np.load(path, allow_pickle=False) as data:
-                version = int(data["format_version"])
-                if version != HIERARCHY_FORMAT_VERSION:
-                    raise ValueError(f"{path}: hierarchy format version {version}, expected "
-                                     f"{HIERARCHY_FORMAT_VERSION}; rebuild it")
-                levels = []
-                for k in range(int(data["depth"])):
-                    shape = tuple(int(s) for s in data[f"level{k}_unpool_shape"])
-                    unpool = sp.csr_matrix((data[f"level{k}_unpool_data"],
-                                            data[f"level{k}_unpool_indices"],
-                                            data[f"level{k}_unpool_indptr"]), shape=shape)
-                    levels.append(PoolLevel(kept=data[f"level{k}_kept"],
-                                            edge_index=data[f"level{k}_edge_index"],
-                                            unpool=unpool, centres=data[f"level{k}_centres"]))
-                return cls(num_vertices=int(data["num_vertices"]),
-                           edge_index=data["edge_index"], levels=levels)
-        except ValueError as error:
-            if str(path) in str(error):
-                raise
+            levels = []
+            for k in range(int(data["depth"])):
+                shape = tuple(int(s) for s in data[f"level{k}_unpool_shape"])
+                unpool = sp.csr_matrix((data[f"level{k}_unpool_data"],
+                                        data[f"level{k}_unpool_indices"],
+                                        data[f"level{k}_unpool_indptr"]), shape=shape)
+                levels.append(PoolLevel(kept=data[f"level{k}_kept"],
+                                        edge_index=data[f"level{k}_edge_index"],
+                                        unpool=unpool, centres=data[f"level{k}_centres"]))
+        except (KeyError, ValueError) as error:
             raise ValueError(f"{path}: corrupt hierarchy file ({error})") from error
-        except (OSError, KeyError, EOFError) as error:
-            raise ValueError(f"{path}: truncated or corrupt hierarchy file ({error})") from error
-        except Exception as error:  # zipfile.BadZipFile and friends
-            raise ValueError(f"{path}: truncated or corrupt hierarchy file ({error})") from error
+        return cls(num_vertices=int(data["num_vertices"]), edge_index=data["edge_index"],
+                   levels=levels)
 
 
 def pool_hierarchy(edge_index: np.ndarray, num_vertices: int, depth: int) -> PoolHierarchy:

@@ -17,6 +17,8 @@ from torch import nn
 
 from gnngarment.body.skeleton import NUM_JOINTS
 from gnngarment.body.skinning import skin
+from gnngarment.data.pair import GarmentBodyPair
+from gnngarment.data.vertex_features import VERTEX_FEATURE_CHANNELS
 from gnngarment.geometry.hierarchy import PoolHierarchy
 from gnngarment.model.body_shape_encoder import BodyShapeEncoder
 from gnngarment.model.config import ModelConfig
@@ -25,29 +27,9 @@ from gnngarment.model.graph_levels import GraphLevels, stack_hierarchies
 from gnngarment.model.motion_encoder import MotionEncoder
 from gnngarment.model.multilevel_processor import MultilevelProcessor
 from gnngarment.model.style_encoder import StyleEncoder
-from gnngarment.model.vertex_features import VERTEX_FEATURE_CHANNELS
 
 #: Per-frame motion state: 24 axis-angles + root displacement (blueprint Eq. 6).
 MOTION_CHANNELS = 3 * (NUM_JOINTS + 1)
-
-
-@dataclass
-class GarmentBodyPair:
-    """Model inputs of one garment on one body (tensors; built by the data layer).
-
-    Attributes:
-        rest_pos: ``(N, 3)`` garment rest positions on the rest body (metres).
-        features: ``(N, 30)`` vertex features (:func:`garment_vertex_features`).
-        hierarchy: the garment's pooling hierarchy (topology only).
-        descriptor: ``(N*,)`` Nyström style descriptor.
-        body_distances: ``(N_b', 24)`` body-shape feature ``D``.
-    """
-
-    rest_pos: torch.Tensor
-    features: torch.Tensor
-    hierarchy: PoolHierarchy
-    descriptor: torch.Tensor
-    body_distances: torch.Tensor
 
 
 @dataclass

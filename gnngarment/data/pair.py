@@ -1,0 +1,28 @@
+"""The model's per garment–body pair input (the data contract between cache and model)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import torch
+
+from gnngarment.geometry.hierarchy import PoolHierarchy
+
+
+@dataclass
+class GarmentBodyPair:
+    """Model inputs of one garment on one body (tensors; built by the data layer).
+
+    Attributes:
+        rest_pos: ``(N, 3)`` garment rest positions on the rest body (metres).
+        features: ``(N, 30)`` vertex features (:func:`garment_vertex_features`).
+        hierarchy: the garment's pooling hierarchy (topology only).
+        descriptor: ``(N*,)`` Nyström style descriptor.
+        body_distances: ``(N_b', 24)`` body-shape feature ``D``.
+    """
+
+    rest_pos: torch.Tensor
+    features: torch.Tensor
+    hierarchy: PoolHierarchy
+    descriptor: torch.Tensor
+    body_distances: torch.Tensor

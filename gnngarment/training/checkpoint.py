@@ -1,0 +1,88 @@
+"""Checkpoints: written atomically, loaded with ``weights_only=True``."""
+
+from __future__ import annotations
+
+import os
+import random
+import tempfile
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from gnngarment.config import merge_config
+from gnngarment.model.config import ModelConfig
+from gnngarment.model.deformer import GarmentDeformer
+
+CHECKPOINT_FORMAT_VERSION = 1
+
+
+def save_checkpoint(path: str | Path, payload: dict[str, Any]) -> None:
+    """``torch.save`` to a temp file in the same folder, then rename: a kill -9 during
+    the write leaves the previous checkpoint intact."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(handle)
+    try:
+        torch.save({"format_version": CHECKPOINT_FORMAT_VERSION, **payload}, temporary)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def load_checkpoint(path: str | Path) -> dict[str, Any]:
+    """Load a checkpoint safely (no pickled code: ``weights_only=True``).
+
+    Raises:
+        ValueError: missing, truncated or foreign file (names it).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"{path}: checkpoint not found")
+    try:
+        payload = torch.load(path, map_location="cpu", weights_only=True)
+    except Exception as error:  # truncated zip, unpickling refusal, ...
+        raise ValueError(f"{path}: not a readable gnngarment checkpoint ({error})") from error
+    if not isinstance(payload, dict) or payload.get("format_version") != CHECKPOINT_FORMAT_VERSION:
+        raise ValueError(f"{path}: not a gnngarment checkpoint (format "
+                         f"{payload.get('format_version') if isinstance(payload, dict) else '?'})")
+    return payload
+
+
+def model_payload(model: GarmentDeformer) -> dict[str, Any]:
+    """What a checkpoint needs to rebuild the model: its config and weights."""
+    return {"model_config": asdict(model.config), "model_state": model.state_dict(),
+            "use_physics": model.use_physics}
+
+
+def load_model(path: str | Path) -> GarmentDeformer:
+    """Rebuild a model from a checkpoint, in eval mode."""
+    payload = load_checkpoint(path)
+    config = merge_config(ModelConfig, payload["model_config"], source=str(path))
+    model = GarmentDeformer(config)
+    model.load_state_dict(payload["model_state"])
+    model.use_physics = bool(payload.get("use_physics", False))
+    model.eval()
+    return model
+
+
+def rng_state() -> dict[str, Any]:
+    """torch, numpy-global and python RNG states as plain tensors/lists (safe to load
+    with ``weights_only``)."""
+    numpy_state = np.random.get_state()
+    return {"torch": torch.get_rng_state(),
+            "numpy": [numpy_state[0], torch.from_numpy(numpy_state[1].astype(np.int64)),
+                      *numpy_state[2:]],
+            "python": [random.getstate()[0], list(random.getstate()[1]), random.getstate()[2]]}
+
+
+def set_rng_state(state: dict[str, Any]) -> None:
+    torch.set_rng_state(state["torch"])
+    kind, keys, position, has_gauss, cached = state["numpy"]
+    np.random.set_state((kind, keys.numpy().astype(np.uint32), position, has_gauss, cached))
+    version, internal, gauss = state["python"]
+    random.setstate((version, tuple(internal), gauss))

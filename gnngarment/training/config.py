@@ -1,0 +1,78 @@
+"""Training settings (defaults mirror ``configs/train/paper.yaml``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from gnngarment.model.config import ModelConfig
+
+
+@dataclass
+class LossWeights:
+    """Weights of the loss terms (blueprint Sec. 3.4)."""
+
+    vertex: float = 100.0
+    edge: float = 15.0
+    normal: float = 50.0
+    collision: float = 1.5
+    gravity: float = 0.1
+    stretch: float = 5.0
+    shear: float = 2.0
+
+
+@dataclass
+class StageConfig:
+    """When to switch stages: a stage ends when its watched metric improved by less than
+    ``threshold`` (relative) over the last ``window`` epochs, or after ``max_epochs``.
+
+    Attributes:
+        supervised_window, supervised_threshold: stage 1 watches the vertex error
+            (blueprint: 50 epochs, 4 %).
+        collision_window, collision_threshold: stage 2 watches the collision term
+            before adding stretch + shear (blueprint: 20 epochs, 5 %).
+        strain_window, strain_threshold: when the final stage ends.
+        physics_scale: stage 2 multiplies the vertex and edge weights by this (0.1).
+        max_epochs: per stage, a hard limit (0 = none).
+    """
+
+    supervised_window: int = 50
+    supervised_threshold: float = 0.04
+    collision_window: int = 20
+    collision_threshold: float = 0.05
+    strain_window: int = 20
+    strain_threshold: float = 0.05
+    physics_scale: float = 0.1
+    max_epochs: list[int] = field(default_factory=lambda: [0, 0, 0])
+
+
+@dataclass
+class TrainingConfig:
+    """Everything ``gnngarment train`` needs.
+
+    Attributes:
+        data: prepared cache folder.
+        output: run folder (checkpoints, TensorBoard logs, metrics).
+        model: network settings.
+        seed: seeds torch, numpy and the batch order.
+        epochs: total epoch limit over all stages.
+        pairs_per_batch, frames_per_pair: a batch is ``P`` sequences × ``B`` frames
+            (the blueprint's batch of 64 = e.g. 4 × 16).
+        learning_rate: Adamax learning rate, decayed by a cosine over ``epochs``.
+        collision_margin: ε of the collision term (metres).
+        threads: torch intra-op threads (0 = torch's default).
+        validate_every: epochs between validation passes.
+    """
+
+    data: str = "data/demo"
+    output: str = "runs/demo"
+    model: ModelConfig = field(default_factory=ModelConfig)
+    losses: LossWeights = field(default_factory=LossWeights)
+    stages: StageConfig = field(default_factory=StageConfig)
+    seed: int = 0
+    epochs: int = 200
+    pairs_per_batch: int = 4
+    frames_per_pair: int = 16
+    learning_rate: float = 3e-3
+    collision_margin: float = 0.004
+    threads: int = 0
+    validate_every: int = 1

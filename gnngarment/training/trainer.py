@@ -1,0 +1,245 @@
+"""The training loop: two stages, progress, TensorBoard, atomic checkpoints, exact resume,
+optional data parallelism (torchrun + DDP, gloo on CPU)."""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from torch import nn
+
+from gnngarment.data.dataset import PreparedDataset, TrainingBatch
+from gnngarment.model.deformer import DeformerOutput, GarmentDeformer
+from gnngarment.training.checkpoint import (
+    load_checkpoint,
+    model_payload,
+    rng_state,
+    save_checkpoint,
+    set_rng_state,
+)
+from gnngarment.training.config import TrainingConfig
+from gnngarment.training.objective import stage_loss
+from gnngarment.training.schedule import StageSchedule
+
+CHECKPOINT_NAME = "last.pt"
+
+
+class TrainingStep(nn.Module):
+    """``prepare`` + ``forward`` as one module call, so DDP sees the whole computation
+    (its gradient hooks cover the per-pair encoders too)."""
+
+    def __init__(self, model: GarmentDeformer):
+        super().__init__()
+        self.model = model
+
+    def forward(self, batch: TrainingBatch) -> DeformerOutput:
+        context = self.model.prepare(batch.pairs)
+        return self.model(context, batch.motion_windows, batch.velocity_windows,
+                          batch.joint_transforms)
+
+
+def set_stage(model: GarmentDeformer, stage: str) -> None:
+    """Freeze/unfreeze for a stage: stage 1 trains all but the physics submodule, the
+    physics stages train only the physics submodule."""
+    physics = stage != "supervised"
+    model.use_physics = physics and model.physics_processor is not None
+    for name, parameter in model.named_parameters():
+        in_physics = name.startswith("physics_processor.")
+        parameter.requires_grad_(in_physics if physics else not in_physics)
+
+
+def _distributed() -> tuple[int, int]:
+    if torch.distributed.is_available() and torch.distributed.is_initialized():
+        return torch.distributed.get_rank(), torch.distributed.get_world_size()
+    return 0, 1
+
+
+class Trainer:
+    """Train a :class:`GarmentDeformer` on a prepared cache.
+
+    Args:
+        config: the run's settings.
+        train: training split; validation: optional split evaluated every
+            ``config.validate_every`` epochs.
+        progress: show progress bars (rank 0 only).
+    """
+
+    def __init__(self, config: TrainingConfig, train: PreparedDataset,
+                 validation: PreparedDataset | None = None, progress: bool = True):
+        self.config = config
+        self.train_data = train
+        self.validation_data = validation
+        self.rank, self.world = _distributed()
+        self.progress = progress and self.rank == 0
+        self.output = Path(config.output)
+        if config.threads:
+            torch.set_num_threads(config.threads)
+        torch.manual_seed(config.seed)
+        self.model = GarmentDeformer(config.model)
+        self.step_module: nn.Module = TrainingStep(self.model)
+        if self.world > 1:
+            self.step_module = nn.parallel.DistributedDataParallel(
+                self.step_module, find_unused_parameters=True)
+        self.optimiser = torch.optim.Adamax(self.model.parameters(), lr=config.learning_rate)
+        self.scheduler = torch.optim.lr_scheduler.CosineAnnealingLR(
+            self.optimiser, T_max=max(config.epochs, 1))
+        self.schedule = StageSchedule(config.stages)
+        self.epoch = 0
+        self.global_step = 0
+        self.history: list[dict[str, Any]] = []
+
+    # ------------------------------------------------------------------ state
+    def checkpoint_path(self) -> Path:
+        return self.output / CHECKPOINT_NAME
+
+    def state(self) -> dict[str, Any]:
+        return {**model_payload(self.model), "optimiser": self.optimiser.state_dict(),
+                "scheduler": self.scheduler.state_dict(), "schedule": self.schedule.state_dict(),
+                "epoch": self.epoch, "global_step": self.global_step, "rng": rng_state(),
+                "training_config": json.dumps(asdict(self.config)),
+                "data_manifest_hash": self.train_data.manifest.get("hash", ""),
+                "history": json.dumps(self.history)}
+
+    def resume(self, path: str | Path | None = None) -> None:
+        """Restore model, optimiser, scheduler, stage state, counters and RNG."""
+        payload = load_checkpoint(path or self.checkpoint_path())
+        self.model.load_state_dict(payload["model_state"])
+        self.schedule.load_state_dict(payload["schedule"])
+        set_stage(self.model, self.schedule.stage)
+        self.optimiser.load_state_dict(payload["optimiser"])
+        self.scheduler.load_state_dict(payload["scheduler"])
+        self.epoch = int(payload["epoch"])
+        self.global_step = int(payload["global_step"])
+        self.history = json.loads(payload["history"])
+        set_rng_state(payload["rng"])
+
+    # ------------------------------------------------------------------ loop
+    def fit(self, resume: bool = False, stop_after: int | None = None) -> dict[str, Any]:
+        """Train until the schedule is done or ``config.epochs`` is reached.
+
+        Args:
+            resume: continue from ``<output>/last.pt`` if it exists.
+            stop_after: run at most this many epochs in this call (the run can be
+                resumed later exactly as if it had not stopped).
+
+        Returns:
+            A summary: final stage, stage switches, last epoch's metrics.
+        """
+        from torch.utils.tensorboard import SummaryWriter
+
+        if resume and self.checkpoint_path().is_file():
+            self.resume()
+        writer = SummaryWriter(str(self.output / "tensorboard")) if self.rank == 0 else None
+        last_epoch = self.config.epochs if stop_after is None else min(
+            self.config.epochs, self.epoch + stop_after)
+        try:
+            while self.epoch < last_epoch and self.schedule.stage != "done":
+                set_stage(self.model, self.schedule.stage)
+                metrics = self.train_epoch()
+                if self.validation_data is not None and (
+                        (self.epoch + 1) % self.config.validate_every == 0):
+                    metrics |= {f"val_{k}": v for k, v in self.validate().items()}
+                self.epoch += 1
+                stage = self.schedule.stage
+                reason = self.schedule.update(metrics, self.epoch)
+                self.scheduler.step()
+                metrics |= {"epoch": self.epoch, "stage": stage,
+                            "learning_rate": self.scheduler.get_last_lr()[0]}
+                self.history.append(metrics)
+                if self.rank == 0:
+                    self._log(writer, metrics, reason)
+                    save_checkpoint(self.checkpoint_path(), self.state())
+        finally:
+            if writer is not None:
+                writer.close()
+        return {"epochs": self.epoch, "stage": self.schedule.stage,
+                "switches": self.schedule.switches,
+                "last": self.history[-1] if self.history else {}}
+
+    def train_epoch(self) -> dict[str, float]:
+        from tqdm import tqdm
+
+        config = self.config
+        self.step_module.train()
+        # The batch order is a pure function of (seed, epoch): resuming at an epoch
+        # boundary replays exactly the batches an uninterrupted run would see.
+        rng = np.random.default_rng([config.seed, self.epoch])
+        groups = list(self.train_data.batches(config.pairs_per_batch, config.frames_per_pair,
+                                              rng))
+        groups = groups[self.rank::self.world]
+        sums: dict[str, float] = {}
+        count = 0
+        started = time.perf_counter()
+        bar = tqdm(groups, desc=f"epoch {self.epoch + 1} [{self.schedule.stage}]",
+                   disable=not self.progress, leave=False, unit="batch")
+        for items in bar:
+            batch = self.train_data.batch(items)
+            output = self.step_module(batch)
+            total, terms = stage_loss(output, batch, self.schedule.stage, config.losses,
+                                      config.stages, config.collision_margin)
+            value = total.item()
+            if not math.isfinite(value):
+                raise FloatingPointError(f"loss became {value} at epoch {self.epoch + 1}"
+                                         f" (terms {terms}); lower the learning rate")
+            self.optimiser.zero_grad(set_to_none=True)
+            total.backward()
+            self.optimiser.step()
+            self.global_step += 1
+            count += 1
+            for name, value in terms.items():
+                sums[name] = sums.get(name, 0.0) + value
+            sums["loss"] = sums.get("loss", 0.0) + value
+            bar.set_postfix(loss=f"{value:.4g}")
+        metrics = {name: value / max(count, 1) for name, value in sums.items()}
+        metrics["vertex_error_mm"] = 1000 * math.sqrt(metrics.get("vertex", 0.0))
+        metrics["seconds"] = time.perf_counter() - started
+        return metrics
+
+    @torch.no_grad()
+    def validate(self) -> dict[str, float]:
+        """Mean vertex error (mm, RMS per vertex) and collision term on the validation
+        split, every frame of every sequence."""
+        from gnngarment.training.objective import loss_terms
+
+        data = self.validation_data
+        assert data is not None
+        self.model.eval()
+        sums: dict[str, float] = {}
+        count = 0
+        for name in data.sequence_names:
+            frames = np.arange(data.frame_counts[name])
+            for start in range(0, len(frames), self.config.frames_per_pair):
+                chunk = frames[start:start + self.config.frames_per_pair]
+                batch = data.batch([(name, chunk)])
+                output = TrainingStep(self.model)(batch)
+                terms = loss_terms(output, batch, ["vertex", "collision"],
+                                   self.config.collision_margin)
+                for key, value in terms.items():
+                    sums[key] = sums.get(key, 0.0) + float(value) * len(chunk)
+                count += len(chunk)
+        metrics = {key: value / max(count, 1) for key, value in sums.items()}
+        metrics["vertex_error_mm"] = 1000 * math.sqrt(metrics["vertex"])
+        return metrics
+
+    def _log(self, writer, metrics: dict[str, Any], reason: str | None) -> None:
+        for name, value in metrics.items():
+            if isinstance(value, (int, float)) and name != "epoch":
+                writer.add_scalar(name, value, self.epoch)
+        line = (f"epoch {self.epoch} [{metrics['stage']}] loss {metrics.get('loss', 0):.4g} "
+                f"vertex {metrics.get('vertex_error_mm', 0):.1f} mm")
+        if "val_vertex_error_mm" in metrics:
+            line += f", val {metrics['val_vertex_error_mm']:.1f} mm"
+        if self.progress:
+            print(line, flush=True)
+        if reason is not None:
+            print(f"stage switch after epoch {self.epoch}: {metrics['stage']} -> "
+                  f"{self.schedule.stage} ({reason})", flush=True)
+        (self.output / "metrics.jsonl").parent.mkdir(parents=True, exist_ok=True)
+        with open(self.output / "metrics.jsonl", "a") as stream:
+            stream.write(json.dumps({**metrics, "switch": reason}) + "\n")

@@ -1,0 +1,89 @@
+"""A tiny model through both stages, checkpoints and exact resume."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import torch
+
+from gnngarment.data import PreparedDataset
+from gnngarment.training.checkpoint import load_checkpoint, load_model
+from gnngarment.training.config import StageConfig, TrainingConfig
+from gnngarment.training.trainer import Trainer
+from tests.model.pairs import tiny_config
+from tests.synthetic_cache import build_synthetic_cache
+
+
+@pytest.fixture(scope="module")
+def cache(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return build_synthetic_cache(tmp_path_factory.mktemp("cache"), frames=6)
+
+
+def config_for(cache: Path, output: Path, epochs: int = 4) -> TrainingConfig:
+    return TrainingConfig(
+        data=str(cache), output=str(output), model=tiny_config(), epochs=epochs,
+        pairs_per_batch=2, frames_per_pair=3, learning_rate=3e-3, threads=1,
+        stages=StageConfig(supervised_window=5, collision_window=5, strain_window=5,
+                           max_epochs=[2, 1, 0]))
+
+
+def make_trainer(config: TrainingConfig, validation: bool = True) -> Trainer:
+    window = config.model.window
+    train = PreparedDataset(config.data, "train", window)
+    val = PreparedDataset(config.data, "val", window) if validation else None
+    return Trainer(config, train, val, progress=False)
+
+
+def test_trains_through_both_stages_and_logs_the_switches(cache: Path, tmp_path: Path) -> None:
+    config = config_for(cache, tmp_path / "run", epochs=4)
+    trainer = make_trainer(config)
+    physics_before = {n: p.clone() for n, p in trainer.model.named_parameters()}
+    summary = trainer.fit()
+
+    assert [s["to"] for s in summary["switches"]] == ["physics", "physics_strain"]
+    assert all("epoch limit" in s["reason"] for s in summary["switches"])
+    lines = [json.loads(x) for x in (tmp_path / "run" / "metrics.jsonl").read_text().splitlines()]
+    assert [line["stage"] for line in lines] == ["supervised", "supervised", "physics",
+                                                 "physics_strain"]
+    assert lines[0]["vertex"] > lines[1]["vertex"]  # stage 1 learns
+    assert {"collision", "gravity"} <= set(lines[2]) and "stretch" in lines[3]
+    assert "val_vertex_error_mm" in lines[0]
+    assert list((tmp_path / "run" / "tensorboard").iterdir())
+    # Stage 2 trained only the physics submodule.
+    after = dict(trainer.model.named_parameters())
+    assert not torch.equal(after["physics_processor.output.lin.weight"],
+                           physics_before["physics_processor.output.lin.weight"])
+    model = load_model(tmp_path / "run" / "last.pt")
+    assert model.use_physics
+
+
+def test_resume_continues_exactly(cache: Path, tmp_path: Path) -> None:
+    straight = make_trainer(config_for(cache, tmp_path / "straight"), validation=False)
+    straight.fit()
+
+    interrupted = make_trainer(config_for(cache, tmp_path / "resumed"), validation=False)
+    interrupted.fit(stop_after=3)  # crosses the stage switch, then "dies"
+    resumed = make_trainer(config_for(cache, tmp_path / "resumed"), validation=False)
+    resumed.fit(resume=True)
+
+    assert resumed.epoch == straight.epoch == 4
+    for (name, a), b in zip(straight.model.state_dict().items(),
+                            resumed.model.state_dict().values(), strict=True):
+        assert torch.equal(a, b), name
+    assert resumed.schedule.state_dict() == straight.schedule.state_dict()
+
+
+def test_checkpoints_are_safe_and_bad_ones_are_named(cache: Path, tmp_path: Path) -> None:
+    config = config_for(cache, tmp_path / "run", epochs=1)
+    make_trainer(config, validation=False).fit()
+    path = tmp_path / "run" / "last.pt"
+    assert load_checkpoint(path)["epoch"] == 1
+    truncated = tmp_path / "truncated.pt"
+    truncated.write_bytes(path.read_bytes()[:1000])
+    with pytest.raises(ValueError, match="truncated.pt: not a readable"):
+        load_checkpoint(truncated)
+    with pytest.raises(ValueError, match="absent.pt: checkpoint not found"):
+        load_checkpoint(tmp_path / "absent.pt")
+    assert [p.name for p in path.parent.iterdir() if p.suffix == ".tmp"] == []
