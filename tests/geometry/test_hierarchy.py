@@ -84,7 +84,7 @@ def test_truncated_and_missing_files_are_named(two_piece, tmp_path: Path) -> Non
     truncated.write_bytes(data[: len(data) // 2])
     with pytest.raises(ValueError, match="truncated.npz"):
         PoolHierarchy.load(truncated)
-    with pytest.raises(ValueError, match="not found"):
+    with pytest.raises(ValueError, match="absent.npz: file not found"):
         PoolHierarchy.load(tmp_path / "absent.npz")
 
 
