@@ -384,6 +384,15 @@ class AnnyBodyModel(BodyModel):
         """``(F_b, 3)`` int64 faces of the body component."""
         return self._faces
 
+    def skinning_weights(self) -> np.ndarray:
+        """Anny's per-bone vertex weights summed onto the canonical joint each bone
+        follows, ``(N_b, 24)`` float32 (rows sum to 1)."""
+        joint = torch.as_tensor(self.bone_joint)[self._indices.long()]
+        weights = torch.zeros(self._weights.shape[0], NUM_JOINTS, dtype=torch.float64)
+        weights.scatter_add_(1, joint, self._weights.double())
+        weights /= weights.sum(1, keepdim=True).clamp_min(1e-12)
+        return weights.numpy().astype(np.float32)
+
     def rest(self, shape: AnnyShape | None = None) -> RestBody:
         rest = self._rest_for(shape or self.default_shape())
         return RestBody(vertices=rest.vertices, faces=self._faces, joints=rest.joints)

@@ -70,6 +70,11 @@ class BodyModel(abc.ABC):
     def pose(self, motion: Motion, shape: Any = None) -> PosedBody:
         """Pose ``shape`` by every frame of ``motion`` (at the motion's own fps)."""
 
+    def skinning_weights(self) -> np.ndarray:
+        """``(N_b, 24)`` the body's own linear-blend-skinning weights per canonical joint
+        (rows sum to 1); used by the body-skinning baseline."""
+        raise NotImplementedError(f"{type(self).__name__} does not expose skinning weights")
+
     # ---- shared helpers ------------------------------------------------------------
     def feature_vertex_indices(self, count: int = 512) -> np.ndarray:
         """The fixed body-vertex subset: ``count`` indices ``(count,)`` into the rest

@@ -127,6 +127,10 @@ class SMPLBodyModel(BodyModel):
         joints = vertices2joints(self.smpl.J_regressor, v_shaped)
         return v_shaped[0], joints[0]
 
+    def skinning_weights(self) -> np.ndarray:
+        """SMPL's ``lbs_weights`` ``(6890, 24)`` float32."""
+        return self.smpl.lbs_weights.detach().cpu().numpy().astype(np.float32)
+
     def rest(self, shape: Any = None) -> RestBody:
         with torch.no_grad():
             vertices, joints = self._shaped(shape)

@@ -57,7 +57,9 @@ def topology_key(faces: np.ndarray) -> str:
 @dataclass
 class GarmentRecord:
     """``garments/<name>.npz``. Shapes: rest_pos ``(N, 3)`` metres on the rest body of
-    ``body``, faces ``(F, 3)``, descriptor ``(N*,)``."""
+    ``body``, faces ``(F, 3)``, descriptor ``(N*,)``; optional body_weights ``(N, 24)``,
+    the body's skinning weights transferred from the nearest body vertices (the
+    body-skinning baseline)."""
 
     name: str
     rest_pos: np.ndarray
@@ -66,6 +68,7 @@ class GarmentRecord:
     topology: str
     garment_type: str
     body: str
+    body_weights: np.ndarray | None = None
 
 
 @dataclass
@@ -118,6 +121,8 @@ def write_garment(root: Path, record: GarmentRecord) -> Path:
     save_npz_atomic(path, {
         "rest_pos": record.rest_pos.astype(np.float32), "faces": record.faces.astype(np.int64),
         "descriptor": record.descriptor.astype(np.float64),
+        **({} if record.body_weights is None
+           else {"body_weights": record.body_weights.astype(np.float32)}),
         **_strings(record, ("topology", "garment_type", "body"))})
     return path
 
@@ -149,7 +154,8 @@ def read_garment(root: Path, name: str) -> GarmentRecord:
     data = load_npz(root / "garments" / f"{name}.npz", GARMENT_ARRAYS)
     return GarmentRecord(name=name, rest_pos=data["rest_pos"], faces=data["faces"],
                          descriptor=data["descriptor"], topology=str(data["topology"]),
-                         garment_type=str(data["garment_type"]), body=str(data["body"]))
+                         garment_type=str(data["garment_type"]), body=str(data["body"]),
+                         body_weights=data.get("body_weights"))
 
 
 def read_body(root: Path, name: str) -> BodyRecord:

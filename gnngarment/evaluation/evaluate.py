@@ -1,0 +1,217 @@
+"""Evaluate a model (and baselines) on a split of a prepared cache."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from gnngarment.body.skinning import skin
+from gnngarment.data.cache import read_body, read_garment
+from gnngarment.data.dataset import PreparedDataset, window_indices
+from gnngarment.evaluation import metrics
+from gnngarment.evaluation.perturbation import (
+    DEFAULT_IRRELEVANT_JOINT,
+    IRRELEVANT_JOINT,
+    perturb_joint,
+)
+from gnngarment.model.deformer import GarmentDeformer
+
+#: Reported columns, in the order of the tables.
+METRICS = ("e_verts_mm", "e_norm_deg", "collision_pct", "hausdorff_mm", "sted",
+           "spurious_mm")
+
+
+@dataclass
+class EvaluationReport:
+    """Metrics per method and garment type (and ``"all"``), averaged over frames of
+    every sequence of the split.
+
+    Attributes:
+        results: ``{method: {garment_type: {metric: value}}}``.
+        sequences: ``{method: {sequence: {metric: value}}}``.
+        split: evaluated split; frames: frames evaluated.
+    """
+
+    split: str
+    results: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)
+    sequences: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)
+    frames: int = 0
+
+    def to_json(self) -> str:
+        return json.dumps({"split": self.split, "frames": self.frames, "results": self.results,
+                           "sequences": self.sequences}, indent=2)
+
+    def to_markdown(self) -> str:
+        """Table in the layout of the blueprint's Table 1: one row per method, one group
+        of columns per garment type."""
+        types = sorted({t for per_type in self.results.values() for t in per_type} - {"all"})
+        types.append("all")
+        header = ["method"] + [f"{t} {m}" for t in types for m in ("E_verts mm", "E_norm °")]
+        lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+        for method, per_type in self.results.items():
+            cells = [method]
+            for t in types:
+                values = per_type.get(t)
+                cells += (["–", "–"] if values is None else
+                          [f"{values['e_verts_mm']:.1f}", f"{values['e_norm_deg']:.1f}"])
+            lines.append("| " + " | ".join(cells) + " |")
+        lines += ["", "| method | " + " | ".join(METRICS) + " |", "|" + "---|" * (len(METRICS) + 1)]
+        for method, per_type in self.results.items():
+            values = per_type["all"]
+            lines.append(f"| {method} | " + " | ".join(
+                "–" if np.isnan(values.get(m, np.nan)) else f"{values[m]:.4g}" for m in METRICS)
+                + " |")
+        return "\n".join(lines)
+
+
+@torch.inference_mode()
+def predict(model: GarmentDeformer, dataset: PreparedDataset, name: str,
+            motion_features: np.ndarray | None = None,
+            joint_transforms: np.ndarray | None = None, chunk: int = 16) -> np.ndarray:
+    """The model's garment for every frame of a sequence, ``(T, N, 3)``; optionally with
+    replaced motion features ``(T, 75)`` / joint transforms ``(T, 24, 4, 4)``."""
+    model.eval()
+    record = dataset.sequence(name)
+    garment = dataset.garment_of(name)
+    context = model.prepare([garment.pair])
+    features = torch.from_numpy(record.motion_features if motion_features is None
+                                else motion_features)
+    transforms = torch.from_numpy(record.joint_transforms if joint_transforms is None
+                                  else joint_transforms)
+    velocity = torch.from_numpy(record.velocities.reshape(record.num_frames, -1))
+    out = []
+    for start in range(0, record.num_frames, chunk):
+        frames = np.arange(start, min(start + chunk, record.num_frames))
+        windows = torch.from_numpy(window_indices(frames, model.config.window))
+        result = model(context, features[windows][None], velocity[windows][None],
+                       transforms[frames][None])
+        out.append(result.posed.view(len(frames), -1, 3))
+    return torch.cat(out).numpy()
+
+
+def body_skinning_prediction(dataset: PreparedDataset, name: str,
+                             joint_transforms: np.ndarray | None = None) -> np.ndarray | None:
+    """The body-skinning baseline's garment ``(T, N, 3)``, or ``None`` when the cache
+    has no transferred body weights for this garment."""
+    info = dataset.manifest["sequences"][name]
+    record = read_garment(dataset.root, info["garment"])
+    if record.body_weights is None:
+        return None
+    transforms = (dataset.sequence(name).joint_transforms if joint_transforms is None
+                  else joint_transforms)
+    posed = skin(torch.from_numpy(record.rest_pos), None,
+                 torch.from_numpy(record.body_weights), torch.from_numpy(transforms))
+    return posed.numpy()
+
+
+def sequence_metrics(pred: np.ndarray, dataset: PreparedDataset, name: str) -> dict[str, float]:
+    """Frame-averaged metrics of one predicted sequence against its ground truth."""
+    record = dataset.sequence(name)
+    garment = dataset.garment_of(name)
+    faces = garment.faces.numpy()
+    edges = garment.edges.numpy().T
+    rest = garment.pair.rest_pos.numpy()
+    target = record.positions
+    return {
+        "e_verts_mm": 1000 * float(metrics.vertex_error(pred, target).mean()),
+        "e_norm_deg": float(metrics.normal_error(pred, target, faces).mean()),
+        "collision_pct": float(metrics.collision_rate(pred, record.body_points,
+                                                      record.body_normals).mean()),
+        "hausdorff_mm": 1000 * float(metrics.hausdorff_distance(pred, target).mean()),
+        "sted": float(metrics.spatio_temporal_edge_difference(pred, target, edges, rest).mean()),
+    }
+
+
+def spurious_change(model: GarmentDeformer | None, dataset: PreparedDataset, name: str,
+                    baseline: np.ndarray, angle: float = 0.6) -> float:
+    """Mean garment change (mm) when an irrelevant joint is rotated by ``angle`` rad
+    (``model=None``: the body-skinning baseline)."""
+    info = dataset.manifest["sequences"][name]
+    joint = IRRELEVANT_JOINT.get(dataset.garment_of(name).garment_type, DEFAULT_IRRELEVANT_JOINT)
+    record = dataset.sequence(name)
+    rest_joints = read_body(dataset.root, info["body"]).joints
+    features, transforms = perturb_joint(record.motion_features, record.joint_transforms,
+                                         rest_joints, joint, np.array([angle, 0.0, 0.0]))
+    if model is None:
+        perturbed = body_skinning_prediction(dataset, name, transforms)
+    else:
+        perturbed = predict(model, dataset, name, features, transforms)
+    return 1000 * float(np.linalg.norm(perturbed - baseline, axis=-1).mean())
+
+
+def _aggregate(per_sequence: dict[str, dict[str, float]], types: dict[str, str],
+               frames: dict[str, int]) -> dict[str, dict[str, float]]:
+    grouped: dict[str, list[str]] = {}
+    for name in per_sequence:
+        grouped.setdefault(types[name], []).append(name)
+    grouped["all"] = list(per_sequence)
+    result = {}
+    for garment_type, names in grouped.items():
+        weights = np.array([frames[n] for n in names], dtype=np.float64)
+        result[garment_type] = {
+            metric: float(np.average([per_sequence[n].get(metric, np.nan) for n in names],
+                                     weights=weights))
+            for metric in METRICS}
+    return result
+
+
+def evaluate(models: dict[str, GarmentDeformer], dataset: PreparedDataset,
+             body_skinning: bool = True, spurious: bool = True,
+             progress: Callable[[str], None] | None = None) -> EvaluationReport:
+    """Metrics of every model in ``models`` (and the body-skinning baseline) on every
+    sequence of ``dataset``'s split.
+
+    Args:
+        models: method name → model.
+        body_skinning: also evaluate the body-skinning baseline (needs transferred
+            body weights in the cache).
+        spurious: run the spurious-correlation test for the models.
+        progress: called with a line per evaluated sequence.
+    """
+    report = EvaluationReport(split=dataset.split)
+    types = {n: dataset.garment_of(n).garment_type for n in dataset.sequence_names}
+    frames = dict(dataset.frame_counts)
+    report.frames = int(sum(frames.values()))
+    methods: dict[str, dict[str, dict[str, float]]] = {m: {} for m in models}
+    if body_skinning:
+        methods["body skinning (LBS)"] = {}
+    for name in dataset.sequence_names:
+        for method, model in models.items():
+            pred = predict(model, dataset, name)
+            values = sequence_metrics(pred, dataset, name)
+            if spurious:
+                values["spurious_mm"] = spurious_change(model, dataset, name, pred)
+            methods[method][name] = values
+        if body_skinning:
+            pred = body_skinning_prediction(dataset, name)
+            if pred is not None:
+                values = sequence_metrics(pred, dataset, name)
+                if spurious:
+                    values["spurious_mm"] = spurious_change(None, dataset, name, pred)
+                methods["body skinning (LBS)"][name] = values
+        if progress is not None:
+            progress(name)
+    for method, per_sequence in methods.items():
+        if per_sequence:
+            report.sequences[method] = per_sequence
+            report.results[method] = _aggregate(per_sequence, types, frames)
+    return report
+
+
+def write_report(report: EvaluationReport, markdown: Path | None = None,
+                 json_path: Path | None = None) -> None:
+    """Write the report's Markdown table and/or JSON atomically."""
+    from gnngarment.data.cache import write_json_atomic
+
+    if json_path is not None:
+        write_json_atomic(Path(json_path), json.loads(report.to_json()))
+    if markdown is not None:
+        path = Path(markdown)
+        temporary = path.with_name(f".{path.name}.tmp")
+        temporary.write_text(report.to_markdown() + "\n")
+        temporary.replace(path)
