@@ -122,6 +122,87 @@ def inspect(
     console.print("seconds: " + ", ".join(f"{k} {v:.3f}" for k, v in seconds.items()))
 
 
+@app.command()
+def train(
+    config: Annotated[Path, typer.Option(help="Training YAML (configs/train/*.yaml).")],
+    resume: Annotated[bool, typer.Option(help="Continue from <output>/last.pt.")] = False,
+    set_: Annotated[list[str] | None, typer.Option(
+        "--set", help="Override a setting, e.g. --set epochs=3 --set model.levels=0.")] = None,
+) -> None:
+    """Train one model across the garments of a prepared cache (both stages)."""
+    import os
+
+    import torch
+
+    from gnngarment.config import ConfigError
+    from gnngarment.data import CacheError, PreparedDataset
+    from gnngarment.training.loading import load_training_config
+    from gnngarment.training.trainer import Trainer
+
+    try:
+        settings = load_training_config(config, set_)
+    except (ConfigError, ValueError) as error:
+        raise fail(str(error)) from None
+    if int(os.environ.get("WORLD_SIZE", "1")) > 1 and not torch.distributed.is_initialized():
+        # Launched by torchrun: one process per rank, gloo on CPU (NCCL needs GPUs).
+        torch.distributed.init_process_group("gloo")
+    try:
+        train_split = PreparedDataset(settings.data, "train", settings.model.window)
+        validation = PreparedDataset(settings.data, "val", settings.model.window)
+    except (CacheError, ValueError) as error:
+        raise fail(str(error)) from None
+    if len(validation) == 0:
+        validation = None
+    trainer = Trainer(settings, train_split, validation)
+    try:
+        summary = trainer.fit(resume=resume)
+    except (CacheError, FloatingPointError) as error:
+        raise fail(str(error)) from None
+    if trainer.rank == 0:
+        console.print(f"[green]done[/]: {summary['epochs']} epochs, stage {summary['stage']}; "
+                      f"checkpoint {trainer.checkpoint_path()}")
+        for switch in summary["switches"]:
+            console.print(f"  epoch {switch['epoch']}: {switch['from']} -> {switch['to']} "
+                          f"({switch['reason']})")
+
+
+@app.command()
+def evaluate(
+    checkpoint: Annotated[Path, typer.Option(help="Model checkpoint (.pt).")],
+    split: Annotated[str, typer.Option(help="Split of the prepared cache.")] = "test",
+    data: Annotated[Path | None, typer.Option(
+        help="Prepared cache (default: the one the checkpoint was trained on).")] = None,
+    json_path: Annotated[Path | None, typer.Option("--json", help="Write the report as JSON.")
+                         ] = None,
+    markdown: Annotated[Path | None, typer.Option(help="Write the Markdown table.")] = None,
+    spurious: Annotated[bool, typer.Option(help="Run the spurious-correlation test.")] = True,
+) -> None:
+    """Report E_verts, E_norm, collision rate, Hausdorff, STED and the spurious-correlation
+    test per garment type, for the model and the body-skinning baseline."""
+    import json as json_module
+
+    from gnngarment.data import CacheError, PreparedDataset
+    from gnngarment.evaluation import evaluate as run_evaluation
+    from gnngarment.evaluation import write_report
+    from gnngarment.training.checkpoint import load_checkpoint, load_model
+
+    try:
+        model = load_model(checkpoint)
+        if data is None:
+            data = Path(json_module.loads(load_checkpoint(checkpoint)["training_config"])["data"])
+        dataset = PreparedDataset(data, split, model.config.window)
+    except (CacheError, ValueError, KeyError) as error:
+        raise fail(str(error)) from None
+    from tqdm import tqdm
+
+    bar = tqdm(total=len(dataset), desc=f"evaluating {split}", unit="sequence")
+    report = run_evaluation({"ours": model}, dataset, spurious=spurious,
+                            progress=lambda name: bar.update(1))
+    bar.close()
+    console.print(report.to_markdown())
+    write_report(report, markdown, json_path)
+
+
 def _register_optional_commands() -> None:
     """Commands of other subpackages register themselves here."""
     try:

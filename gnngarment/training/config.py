@@ -63,8 +63,8 @@ class TrainingConfig:
         validate_every: epochs between validation passes.
     """
 
-    data: str = "data/demo"
-    output: str = "runs/demo"
+    data: str = "data/paper"
+    output: str = "runs/paper"
     model: ModelConfig = field(default_factory=ModelConfig)
     losses: LossWeights = field(default_factory=LossWeights)
     stages: StageConfig = field(default_factory=StageConfig)
