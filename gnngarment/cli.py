@@ -123,6 +123,53 @@ def inspect(
 
 
 @app.command()
+def prepare(
+    config: Annotated[Path | None, typer.Option(help="Dataset YAML (configs/data/*.yaml).")
+                      ] = None,
+    workers: Annotated[int | None, typer.Option(help="Simulation processes (default: cores).")
+                       ] = None,
+    from_cloth3d: Annotated[Path | None, typer.Option(
+        "--from-cloth3d", help="Build the cache from a CLOTH3D folder instead.")] = None,
+    smpl_model: Annotated[Path | None, typer.Option(help="SMPL model file (CLOTH3D).")] = None,
+    output: Annotated[Path | None, typer.Option(help="Cache folder (overrides the config).")
+                      ] = None,
+) -> None:
+    """Build (or resume) a dataset: simulate with Newton and write the prepared cache."""
+    from gnngarment.config import ConfigError, load_config
+
+    if from_cloth3d is not None:
+        from data_prep.cloth3d_build import build_from_cloth3d
+
+        if smpl_model is None:
+            raise fail("--from-cloth3d needs --smpl-model FILE (SMPL is not shipped: get it "
+                       "from https://smpl.is.tue.mpg.de)")
+        try:
+            report = build_from_cloth3d(from_cloth3d, smpl_model, output or Path("data/cloth3d"))
+        except ValueError as error:
+            raise fail(str(error)) from None
+        console.print(report)
+        return
+    if config is None:
+        raise fail("give --config configs/data/<name>.yaml (or --from-cloth3d DIR)")
+    from data_prep.build import build_dataset
+    from data_prep.config import DataConfig
+
+    try:
+        settings = load_config(config, DataConfig)
+    except ConfigError as error:
+        raise fail(str(error)) from None
+    if output is not None:
+        settings.output = str(output)
+    try:
+        report = build_dataset(settings, workers=workers, log=console.print)
+    except (ValueError, OSError) as error:
+        raise fail(str(error)) from None
+    console.print(f"[green]done[/] in {report['seconds']:.0f} s: splits {report['splits']}, "
+                  f"{len(report['failed_sequences'])} sequence(s) left out; "
+                  f"cache in {report['output']}")
+
+
+@app.command()
 def train(
     config: Annotated[Path, typer.Option(help="Training YAML (configs/train/*.yaml).")],
     resume: Annotated[bool, typer.Option(help="Continue from <output>/last.pt.")] = False,
