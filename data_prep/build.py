@@ -260,14 +260,18 @@ def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[s
         return {"name": plan.name, "ok": True, "frames": len(motion),
                 "seconds": time.perf_counter() - started,
                 "seconds_per_frame": result.seconds_per_frame, "attempts": result.attempts,
-                "max_stretch": float(result.quality.max_stretch),
-                "max_inside": float(result.quality.max_inside_fraction)}
+                "max_stretch": float(np.nanmax(result.quality.max_stretch)),
+                "max_inside_pct": 100 * float(np.nanmax(result.quality.inside_fraction))}
     except SimulationFailed as error:
         return {"name": plan.name, "ok": False, "reason": str(error),
                 "seconds": time.perf_counter() - started}
     except Exception as error:  # a broken garment or body: report, don't kill the build
-        return {"name": plan.name, "ok": False, "reason": f"{type(error).__name__}: {error}",
-                "seconds": time.perf_counter() - started}
+        import traceback
+
+        where = traceback.extract_tb(error.__traceback__)[-1]
+        return {"name": plan.name, "ok": False,
+                "reason": f"{type(error).__name__}: {error} ({Path(where.filename).name}:"
+                          f"{where.lineno})", "seconds": time.perf_counter() - started}
 
 
 def _sequence_done(root: Path, name: str, inputs_hash: str) -> bool:
