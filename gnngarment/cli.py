@@ -250,6 +250,34 @@ def evaluate(
     write_report(report, markdown, json_path)
 
 
+@app.command("benchmark-accuracy")
+def benchmark_accuracy(
+    config: Annotated[Path, typer.Option(help="Training YAML shared by every variant.")],
+    output: Annotated[Path, typer.Option(help="Markdown table to write.")
+                      ] = Path("docs/results.md"),
+    variant: Annotated[list[str] | None, typer.Option(help="Only these variants.")] = None,
+    split: Annotated[str, typer.Option(help="Evaluated split.")] = "test",
+) -> None:
+    """Train ours and the pooling/single-level baselines with one budget, evaluate them
+    (and body-skinning LBS) before and after the physics stage, write the table."""
+    import sys
+
+    from gnngarment.config import ConfigError
+    from gnngarment.evaluation.benchmark import VARIANTS, run_benchmark
+    from gnngarment.training.loading import load_training_config
+
+    unknown = [v for v in variant or [] if v not in VARIANTS]
+    if unknown:
+        raise fail(f"unknown variant(s) {unknown}; choose from {list(VARIANTS)}")
+    try:
+        settings = load_training_config(config)
+    except (ConfigError, ValueError) as error:
+        raise fail(str(error)) from None
+    result = run_benchmark(settings, output, variant, split,
+                           command="gnngarment " + " ".join(sys.argv[1:]))
+    console.print(f"[green]wrote[/] {output}: {len(result['rows'])} rows")
+
+
 def _register_optional_commands() -> None:
     """Commands of other subpackages register themselves here."""
     try:

@@ -28,6 +28,7 @@ from gnngarment.training.objective import stage_loss
 from gnngarment.training.schedule import StageSchedule
 
 CHECKPOINT_NAME = "last.pt"
+SUPERVISED_CHECKPOINT_NAME = "supervised.pt"
 
 
 class TrainingStep(nn.Module):
@@ -155,6 +156,9 @@ class Trainer:
                 if self.rank == 0:
                     self._log(writer, metrics, reason)
                     save_checkpoint(self.checkpoint_path(), self.state())
+                    if reason is not None and stage == "supervised":
+                        # The model before the physics stage, for before/after comparisons.
+                        save_checkpoint(self.output / SUPERVISED_CHECKPOINT_NAME, self.state())
         finally:
             if writer is not None:
                 writer.close()

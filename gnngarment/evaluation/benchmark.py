@@ -1,0 +1,70 @@
+"""``gnngarment benchmark-accuracy``: train and evaluate ours and the baselines on the same
+data with the same budget, and write the comparison table (docs/results.md)."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from gnngarment.data.dataset import PreparedDataset
+from gnngarment.evaluation.evaluate import METRICS, evaluate
+from gnngarment.training.checkpoint import load_model
+from gnngarment.training.config import TrainingConfig
+from gnngarment.training.trainer import CHECKPOINT_NAME, SUPERVISED_CHECKPOINT_NAME, Trainer
+
+#: name → (levels, pooling); every variant shares all other settings.
+VARIANTS = {
+    "ours (2 levels)": (2, "structure"),
+    "single level": (0, "structure"),
+    "TopKPool": (2, "topk"),
+    "SAGPool": (2, "sag"),
+    "ASAPool": (2, "asap"),
+}
+
+
+def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | None = None,
+                  split: str = "test", command: str = "") -> dict[str, Any]:
+    """Train every variant with ``config`` (levels/pooling changed only), evaluate each
+    before and after the physics stage, and write ``output`` (Markdown)."""
+    names = variants or list(VARIANTS)
+    rows: dict[str, dict[str, float]] = {}
+    seconds: dict[str, float] = {}
+    lbs: dict[str, float] | None = None
+    for name in names:
+        levels, pooling = VARIANTS[name]
+        variant = replace(config, output=str(Path(config.output) / name.replace(" ", "_")
+                                                 .replace("(", "").replace(")", "")),
+                          model=replace(config.model, levels=levels, pooling=pooling))
+        started = time.perf_counter()
+        train = PreparedDataset(variant.data, "train", variant.model.window)
+        trainer = Trainer(variant, train, None, progress=True)
+        trainer.fit(resume=True)
+        seconds[name] = time.perf_counter() - started
+        test = PreparedDataset(variant.data, split, variant.model.window)
+        run_folder = Path(variant.output)
+        for label, checkpoint in (("supervised", SUPERVISED_CHECKPOINT_NAME),
+                                  ("+ physics", CHECKPOINT_NAME)):
+            path = run_folder / checkpoint
+            if not path.is_file():
+                continue
+            report = evaluate({name: load_model(path)}, test, body_skinning=lbs is None)
+            rows[f"{name}, {label}"] = report.results[name]["all"]
+            if lbs is None and "body skinning (LBS)" in report.results:
+                lbs = report.results["body skinning (LBS)"]["all"]
+    if lbs is not None:
+        rows = {"body skinning (LBS)": lbs, **rows}
+    lines = ["# Accuracy on held-out garments, bodies and motions", "",
+             f"Split `{split}` of `{config.data}`; every learned variant trained with the same "
+             f"config ({config.epochs} epochs max, same stage rules, seed {config.seed}).", "",
+             f"Command: `{command}`" if command else "", "",
+             "| method | " + " | ".join(METRICS) + " |", "|" + "---|" * (len(METRICS) + 1)]
+    for name, values in rows.items():
+        lines.append(f"| {name} | " + " | ".join(f"{values.get(m, float('nan')):.4g}"
+                                                  for m in METRICS) + " |")
+    lines += ["", "Training time per variant (s): " + ", ".join(
+        f"{k} {v:.0f}" for k, v in seconds.items())]
+    output.parent.mkdir(parents=True, exist_ok=True)
+    output.write_text("\n".join(lines) + "\n")
+    return {"rows": rows, "seconds": seconds}
