@@ -84,9 +84,7 @@ class Trainer:
         torch.manual_seed(config.seed)
         self.model = GarmentDeformer(config.model)
         self.step_module: nn.Module = TrainingStep(self.model)
-        if self.world > 1:
-            self.step_module = nn.parallel.DistributedDataParallel(
-                self.step_module, find_unused_parameters=True)
+        self._wrapped_stage: str | None = None
         self.optimiser = torch.optim.Adamax(self.model.parameters(), lr=config.learning_rate)
         self.scheduler = torch.optim.lr_scheduler.CosineAnnealingLR(
             self.optimiser, T_max=max(config.epochs, 1))
@@ -142,6 +140,7 @@ class Trainer:
         try:
             while self.epoch < last_epoch and self.schedule.stage != "done":
                 set_stage(self.model, self.schedule.stage)
+                self._wrap_for_stage()
                 metrics = self.train_epoch()
                 if self.validation_data is not None and (
                         (self.epoch + 1) % self.config.validate_every == 0):
@@ -165,6 +164,15 @@ class Trainer:
         return {"epochs": self.epoch, "stage": self.schedule.stage,
                 "switches": self.schedule.switches,
                 "last": self.history[-1] if self.history else {}}
+
+    def _wrap_for_stage(self) -> None:
+        """With several processes, (re)wrap in DDP whenever the trainable set changes:
+        DDP only synchronises the parameters that required gradients when it was built."""
+        if self.world == 1 or self._wrapped_stage == self.schedule.stage:
+            return
+        self.step_module = nn.parallel.DistributedDataParallel(
+            TrainingStep(self.model), find_unused_parameters=True)
+        self._wrapped_stage = self.schedule.stage
 
     def train_epoch(self) -> dict[str, float]:
         from tqdm import tqdm
