@@ -26,7 +26,14 @@ install: $(STAMP)
 demo: $(STAMP)
 	$(PY) -m gnngarment.demo --out $(OUT)
 
-test: $(STAMP)
+NODE_STAMP := node_modules/.installed
+
+# The Khronos glTF validator (npm `gltf-validator`) checks our .glb exports in the tests.
+$(NODE_STAMP): package.json package-lock.json
+	npm ci --silent --no-audit --no-fund
+	touch $(NODE_STAMP)
+
+test: $(STAMP) $(NODE_STAMP)
 	$(VENV)/bin/ruff check .
 	$(PY) -m pytest
 
@@ -37,4 +44,4 @@ bench: $(STAMP)
 	$(PY) benchmarks/prepare_garment.py
 
 clean:
-	rm -rf $(VENV) $(OUT) .pytest_cache .ruff_cache
+	rm -rf $(VENV) $(OUT) node_modules .pytest_cache .ruff_cache

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from data_prep.config import DataConfig
+from gnngarment.geometry.files import atomic_write, atomic_write_bytes
 
 #: Bumped when the builder's output changes for the same config (forces a rebuild).
 BUILDER_VERSION = 1
@@ -193,7 +194,7 @@ def prepare_garment_record(root: Path, design: DesignPlan, body: BodyPlan,
                                       descriptor=prepared.descriptor, topology=key,
                                       garment_type=design.garment_type, body=body.name,
                                       body_weights=weights))
-    np.save(root / "garments" / f"{name}.pinned.npy", pinned)
+    atomic_write(root / "garments" / f"{name}.pinned.npy", lambda stream: np.save(stream, pinned))
     return {"vertices": len(pos), "faces": len(faces), "pinned": len(pinned)}
 
 
@@ -256,7 +257,7 @@ def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[s
                                        result.positions - translation[:, None, :])})
         path = write_sequence(root, record)
         # The input hash lives beside the file: the next build skips this sequence.
-        (path.parent / f"{plan.name}.hash").write_text(inputs_hash)
+        atomic_write_bytes(path.parent / f"{plan.name}.hash", inputs_hash.encode())
         return {"name": plan.name, "ok": True, "frames": len(motion),
                 "seconds": time.perf_counter() - started,
                 "seconds_per_frame": result.seconds_per_frame, "attempts": result.attempts,
@@ -368,7 +369,7 @@ def build_dataset(config: DataConfig, workers: int | None = None,
         else None,
         "manifest_hash": manifest["hash"], "garments": garment_info,
     }
-    (root / "build_report.json").write_text(json.dumps(report, indent=2))
+    atomic_write_bytes(root / "build_report.json", json.dumps(report, indent=2).encode())
     return report
 
 

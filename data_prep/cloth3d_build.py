@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from gnngarment.geometry.files import atomic_write_bytes
+
 #: A garment vertex is "on the body" within this median distance (metres).
 ALIGNMENT_TOLERANCE = 0.10
 #: CLOTH3D's split folders, mapped to our split names.
@@ -129,5 +131,5 @@ def build_from_cloth3d(root: str | Path, smpl_model: str | Path, output: str | P
     report = {"output": str(output), "seconds": time.perf_counter() - started,
               "splits": {k: len(v) for k, v in splits.items()}, "skipped": skipped,
               "manifest_hash": manifest["hash"]}
-    (output / "build_report.json").write_text(json.dumps(report, indent=2))
+    atomic_write_bytes(output / "build_report.json", json.dumps(report, indent=2).encode())
     return report

@@ -16,14 +16,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from gnngarment.geometry.files import load_npz, save_npz_atomic
+from gnngarment.geometry.files import atomic_write_bytes, load_npz, save_npz_atomic
 from gnngarment.geometry.hierarchy import PoolHierarchy
 
 #: Bumped when the layout of any cache file changes: older caches are rebuilt.
@@ -196,15 +194,7 @@ def write_topology(root: Path, key: str, hierarchy: PoolHierarchy) -> Path:
 
 def write_json_atomic(path: Path, payload: dict) -> None:
     """JSON written to a temp file and renamed (the manifest is the commit point)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(handle, "w") as stream:
-            json.dump(payload, stream, indent=2, sort_keys=True)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+    atomic_write_bytes(path, json.dumps(payload, indent=2, sort_keys=True).encode())
 
 
 def read_manifest(root: str | Path) -> dict:

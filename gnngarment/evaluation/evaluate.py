@@ -206,12 +206,9 @@ def evaluate(models: dict[str, GarmentDeformer], dataset: PreparedDataset,
 def write_report(report: EvaluationReport, markdown: Path | None = None,
                  json_path: Path | None = None) -> None:
     """Write the report's Markdown table and/or JSON atomically."""
-    from gnngarment.data.cache import write_json_atomic
+    from gnngarment.geometry.files import atomic_write_bytes
 
     if json_path is not None:
-        write_json_atomic(Path(json_path), json.loads(report.to_json()))
+        atomic_write_bytes(json_path, report.to_json().encode())
     if markdown is not None:
-        path = Path(markdown)
-        temporary = path.with_name(f".{path.name}.tmp")
-        temporary.write_text(report.to_markdown() + "\n")
-        temporary.replace(path)
+        atomic_write_bytes(markdown, (report.to_markdown() + "\n").encode())

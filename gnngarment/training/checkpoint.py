@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import os
 import random
-import tempfile
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -13,6 +11,7 @@ import numpy as np
 import torch
 
 from gnngarment.config import merge_config
+from gnngarment.geometry.files import atomic_write
 from gnngarment.model.config import ModelConfig
 from gnngarment.model.deformer import GarmentDeformer
 
@@ -22,16 +21,8 @@ CHECKPOINT_FORMAT_VERSION = 1
 def save_checkpoint(path: str | Path, payload: dict[str, Any]) -> None:
     """``torch.save`` to a temp file in the same folder, then rename: a kill -9 during
     the write leaves the previous checkpoint intact."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(handle)
-    try:
-        torch.save({"format_version": CHECKPOINT_FORMAT_VERSION, **payload}, temporary)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+    atomic_write(path, lambda stream: torch.save(
+        {"format_version": CHECKPOINT_FORMAT_VERSION, **payload}, stream))
 
 
 def load_checkpoint(path: str | Path) -> dict[str, Any]:

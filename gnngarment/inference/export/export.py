@@ -1,0 +1,138 @@
+"""Write every export of an animated garment into one folder (``export_animation``).
+
+Layout of ``out_dir`` for ``name="skirt"`` (each file written atomically)::
+
+    skirt.glb              skinned garment + skeleton animation + per-frame morph targets
+                           (+ the body as a morph-only mesh with include_body)
+    skirt.pc2              garment point cache, float32, input vertex order
+    skirt_rest.obj         the garment rest mesh the .pc2 applies to (same vertex order)
+    skirt_body.pc2         body point cache            (include_body)
+    skirt_body.obj         body base mesh, first frame (include_body)
+    skirt_obj/garment_0001.obj …   one OBJ per frame   (body_0001.obj … with include_body)
+    skirt.gif              preview
+    skirt_export.json      manifest: frames, fps, numbering, files, glb error
+
+Frames are numbered from ``first_frame`` (1, Blender's default first frame) in OBJ names
+and the ``.pc2`` header; ``Animation.posed[0]`` is frame 1.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from gnngarment.inference.export.atomic import atomic_write_bytes
+from gnngarment.inference.export.gltf import write_glb
+from gnngarment.inference.export.obj_sequence import write_obj, write_obj_sequence
+from gnngarment.inference.export.point_cache import write_point_cache
+from gnngarment.inference.export.preview import render_preview
+from gnngarment.inference.export.validation import check_animation
+
+if TYPE_CHECKING:
+    from gnngarment.inference.animate import Animation
+
+FORMATS = ("obj", "pc2", "glb", "gif", "mp4")
+DEFAULT_FORMATS = ("obj", "pc2", "glb", "gif")
+
+#: ``progress(stage, done, total)``: stage is one of :data:`FORMATS`.
+Progress = Callable[[str, int, int], None]
+
+
+def export_animation(animation: Animation, out_dir: str | Path, name: str,
+                     formats: tuple[str, ...] | list[str] = DEFAULT_FORMATS,
+                     include_body: bool = True, progress: Progress | None = None, *,
+                     first_frame: int = 1, max_influences: int = 4,
+                     morph_interpolation: str = "LINEAR", preview_size: int = 288,
+                     preview_max_frames: int = 48) -> dict[str, Path]:
+    """Export an animation in the requested formats.
+
+    Args:
+        animation: the prediction (:func:`~gnngarment.inference.animate.animate`).
+        out_dir: output folder (created).
+        name: file stem, e.g. the garment's name (letters, digits, ``-``, ``_``, ``.``).
+        formats: any of ``"obj"``, ``"pc2"``, ``"glb"``, ``"gif"`` (``"mp4"`` needs the
+            optional ``imageio-ffmpeg``).
+        include_body: also export the posed body (OBJ sequence, point cache, glb mesh,
+            preview).
+        progress: called as ``progress(stage, done, total)``.
+        first_frame: number of the first frame in OBJ names and the ``.pc2`` header.
+        max_influences: joints per vertex in the glb skin (4, or up to 8).
+        morph_interpolation: glb morph weights, ``"LINEAR"`` or ``"STEP"``.
+        preview_size: preview height/width in pixels.
+        preview_max_frames: the preview renders every k-th frame to stay under this.
+
+    Returns:
+        Paths by key: ``"glb"``, ``"pc2"``, ``"rest_obj"``, ``"body_pc2"``, ``"body_obj"``,
+        ``"obj"`` (the folder), ``"gif"``/``"mp4"``, ``"manifest"`` — those written.
+
+    Raises:
+        ValueError: unknown format, bad name, or an inconsistent animation.
+    """
+    unknown = sorted(set(formats) - set(FORMATS))
+    if unknown or not formats:
+        raise ValueError(f"formats must be a non-empty subset of {FORMATS}, got {formats}")
+    if not name or not all(c.isalnum() or c in "-_." for c in name) or name.startswith("."):
+        raise ValueError(f"name must be a plain file stem (letters, digits, - _ .), "
+                         f"got {name!r}")
+    check_animation(animation, body=include_body)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    frames = len(animation.posed)
+    paths: dict[str, Path] = {}
+    manifest: dict = {
+        "name": name, "frames": frames, "fps": float(animation.fps),
+        "first_frame": first_frame, "garment_vertices": int(animation.posed.shape[1]),
+        "units": "metres", "up_axis": "Z (OBJ, PC2); Y (glb, per the glTF spec)",
+    }
+
+    def report(stage: str) -> Callable[[int, int], None] | None:
+        if progress is None:
+            return None
+        return lambda done, total: progress(stage, done, total)
+
+    if "glb" in formats:
+        result = write_glb(animation, out / f"{name}.glb", name=name,
+                           max_influences=max_influences,
+                           morph_interpolation=morph_interpolation, include_body=include_body)
+        paths["glb"] = result.path
+        manifest["glb"] = {
+            "max_influences": max_influences, "morph_interpolation": morph_interpolation,
+            "max_error_mm": 1000 * result.max_error, "mean_error_mm": 1000 * result.mean_error,
+            "skin_only_max_error_mm": 1000 * result.skin_only_max_error,
+            "skin_only_mean_error_mm": 1000 * result.skin_only_mean_error,
+            "ill_conditioned": result.ill_conditioned, "bytes": result.num_bytes}
+        if progress is not None:
+            progress("glb", 1, 1)
+    if "pc2" in formats:
+        header = {"start_frame": float(first_frame), "sample_rate": 1.0}
+        paths["pc2"] = write_point_cache(out / f"{name}.pc2", animation.posed, **header)
+        paths["rest_obj"] = write_obj(out / f"{name}_rest.obj", animation.rest_pos,
+                                      animation.faces, header=f"{name} rest mesh (metres, Z up)")
+        if include_body:
+            paths["body_pc2"] = write_point_cache(out / f"{name}_body.pc2",
+                                                  animation.body_vertices, **header)
+            paths["body_obj"] = write_obj(out / f"{name}_body.obj", animation.body_vertices[0],
+                                          animation.body_faces,
+                                          header=f"{name} body, frame {first_frame}")
+        if progress is not None:
+            progress("pc2", 1, 1)
+    if "obj" in formats:
+        folder = out / f"{name}_obj"
+        write_obj_sequence(folder, animation.posed, animation.faces, "garment", first_frame,
+                           report("obj"))
+        if include_body:
+            write_obj_sequence(folder, animation.body_vertices, animation.body_faces, "body",
+                               first_frame)
+        paths["obj"] = folder
+    for preview in ("gif", "mp4"):
+        if preview in formats:
+            paths[preview] = render_preview(
+                animation, out / f"{name}.{preview}", size=preview_size,
+                max_frames=preview_max_frames, include_body=include_body,
+                progress=report(preview))
+    manifest["files"] = {key: path.name for key, path in paths.items()}
+    paths["manifest"] = atomic_write_bytes(out / f"{name}_export.json",
+                                           json.dumps(manifest, indent=2).encode())
+    return paths
