@@ -250,6 +250,114 @@ def evaluate(
     write_report(report, markdown, json_path)
 
 
+def _load_body_and_motion(body_shape: str, motion: str, fps: float, duration: float):
+    """Anny body, its shape and a motion (procedural name or file), or a clear failure."""
+    from gnngarment.body import AnnyBodyModel, MotionError, load_motion
+
+    body_model = AnnyBodyModel()
+    try:
+        shape = body_model.parse_shape(body_shape)
+    except (ValueError, OSError) as error:
+        raise fail(f"--body-shape {body_shape}: {error}") from None
+    try:
+        motion_value = load_motion(motion, fps=fps, **(
+            {"duration": duration} if not Path(motion).suffix else {}))
+    except (MotionError, ValueError, OSError) as error:
+        raise fail(f"--motion {motion}: {error}") from None
+    return body_model, shape, motion_value
+
+
+@app.command()
+def animate(
+    garment_mesh: Annotated[Path, typer.Argument(help="Garment in the rest body's frame.")],
+    out: Annotated[Path, typer.Option(help="Output folder.")] = Path("animated"),
+    checkpoint: Annotated[Path | None, typer.Option(
+        help="Model checkpoint (default: the shipped models/gnngarment-small.pt).")] = None,
+    body_shape: Annotated[str, typer.Option(
+        help="Anny preset name or a .json/.yaml phenotype file.")] = "average",
+    motion: Annotated[str, typer.Option(
+        help="Procedural motion name (gnngarment motions) or .npz/.bvh/info.mat.")] = "walk",
+    duration: Annotated[float, typer.Option(help="Seconds of a procedural motion.")] = 2.0,
+    fps: Annotated[float, typer.Option(help="Frames per second.")] = 30.0,
+    formats: Annotated[str, typer.Option("--format", help="Comma list: obj,pc2,glb,gif.")
+                       ] = "obj,pc2,glb,gif",
+    body: Annotated[bool, typer.Option(help="Also export the posed body.")] = True,
+    fix_units: Annotated[str, typer.Option(
+        "--fix-units", help="Garment units: auto, m, cm or mm.")] = "auto",
+    up_axis: Annotated[str, typer.Option(help="Garment up axis: z, y or auto.")] = "z",
+    ignore_placement: Annotated[bool, typer.Option(
+        help="Animate even if the garment does not sit on the body.")] = False,
+    influences: Annotated[int, typer.Option(help="Joints per vertex in the glb skin.")] = 4,
+) -> None:
+    """Animate a garment mesh on a body and motion; write OBJ/PC2/glb/GIF."""
+    from tqdm import tqdm
+
+    from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs
+    from gnngarment.geometry.errors import MeshError
+    from gnngarment.geometry.mesh_io import load_mesh
+    from gnngarment.inference.animate import animate as run_animation
+    from gnngarment.inference.checks import check_garment_placement, fix_placement
+    from gnngarment.inference.export import export_animation
+    from gnngarment.paths import SHIPPED_MODEL
+    from gnngarment.training.checkpoint import load_model
+
+    checkpoint = checkpoint or SHIPPED_MODEL
+    try:
+        model = load_model(checkpoint)
+        pos, faces = load_mesh(garment_mesh)
+    except (MeshError, ValueError) as error:
+        raise fail(str(error)) from None
+    body_model, shape, motion_value = _load_body_and_motion(body_shape, motion, fps, duration)
+    body_inputs = body_shape_inputs(body_model, shape, model.config.body_vertices)
+    try:
+        pos, message = fix_placement(pos, units=fix_units, up_axis=up_axis,
+                                     body_vertices=body_inputs.rest_vertices,
+                                     body_faces=body_inputs.faces)
+    except ValueError as error:
+        raise fail(f"{garment_mesh}: {error}") from None
+    if message:
+        console.print(f"[yellow]placement:[/] {message}")
+    findings = check_garment_placement(pos, faces, body_inputs.rest_vertices, body_inputs.faces)
+    for finding in findings:
+        colour = "red" if finding.severity == "error" else "yellow"
+        console.print(f"[{colour}]{finding.severity}:[/] {garment_mesh}: {finding.message}")
+    if any(f.severity == "error" for f in findings) and not ignore_placement:
+        raise fail(f"{garment_mesh}: the garment is not on the rest body (see above; fix it "
+                   "or pass --fix-units/--up-axis, or --ignore-placement)")
+    frames = body_motion_inputs(body_model, shape, motion_value, model.config.body_vertices)
+    bar = tqdm(total=len(motion_value), desc="animating", unit="frame")
+
+    def advance(done: int, total: int) -> None:
+        bar.update(done - bar.n)
+
+    try:
+        animation = run_animation(model, pos, faces, body_inputs, frames, source=str(garment_mesh),
+                                  progress=advance)
+    except MeshError as error:
+        raise fail(str(error)) from None
+    bar.close()
+    stages: dict[str, tqdm] = {}
+
+    def exported(stage: str, done: int, total: int) -> None:
+        if stage not in stages:
+            stages[stage] = tqdm(total=total, desc=f"writing {stage}", unit="file")
+        stages[stage].update(done - stages[stage].n)
+
+    try:
+        paths = export_animation(
+            animation, out, garment_mesh.stem, formats=[f.strip() for f in formats.split(",")],
+            include_body=body, max_influences=influences, progress=exported)
+    except ValueError as error:
+        raise fail(str(error)) from None
+    for stage_bar in stages.values():
+        stage_bar.close()
+    seconds = animation.seconds
+    console.print(f"[green]animated[/] {len(motion_value)} frames "
+                  f"(context {seconds['context']:.2f} s, frames {seconds['frames']:.2f} s); wrote:")
+    for key, path in paths.items():
+        console.print(f"  {key}: {path}")
+
+
 @app.command("benchmark-accuracy")
 def benchmark_accuracy(
     config: Annotated[Path, typer.Option(help="Training YAML shared by every variant.")],

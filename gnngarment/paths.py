@@ -13,3 +13,7 @@ def default_config(name: str) -> Path:
     """Path of ``configs/<name>``; the file may be absent in a non-editable install,
     in which case callers fall back to their dataclass defaults (which mirror it)."""
     return CONFIG_DIRECTORY / name
+
+#: The pretrained checkpoint kept in the repository (trained by
+#: ``gnngarment train --config configs/train/shipped.yaml``; see models/README.md).
+SHIPPED_MODEL = REPOSITORY_ROOT / "models" / "gnngarment-small.pt"

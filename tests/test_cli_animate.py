@@ -1,0 +1,82 @@
+"""`gnngarment animate` as a user runs it: a garment file on the Anny body."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+import trimesh
+from typer.testing import CliRunner
+
+from data_prep.garments.skirt import flared_skirt
+from gnngarment.cli import app
+from gnngarment.geometry import load_mesh
+from gnngarment.inference.export import read_point_cache
+from gnngarment.model import GarmentDeformer
+from gnngarment.training.checkpoint import model_payload, save_checkpoint
+from tests.model.pairs import tiny_config
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory: pytest.TempPathFactory, anny_body) -> dict[str, Path]:
+    folder = tmp_path_factory.mktemp("animate")
+    torch.manual_seed(0)
+    checkpoint = folder / "model.pt"
+    save_checkpoint(checkpoint, model_payload(GarmentDeformer(tiny_config())))
+    rest = anny_body.rest()
+    pelvis = rest.joints[0].numpy()
+    pos, faces = flared_skirt(400, waist_radius=0.17, hem_radius=0.3, length=0.4,
+                              waist_height=pelvis[2] + 0.08, seed=1)
+    pos[:, :2] += pelvis[:2]
+    garment = folder / "skirt.obj"
+    trimesh.Trimesh(pos, faces, process=False).export(garment)
+    centimetres = folder / "skirt_cm.obj"
+    trimesh.Trimesh(pos * 100, faces, process=False).export(centimetres)
+    return {"checkpoint": checkpoint, "garment": garment, "cm": centimetres, "folder": folder}
+
+
+def test_animate_writes_exports_in_the_input_vertex_order(files) -> None:
+    out = files["folder"] / "out"
+    result = runner.invoke(app, ["animate", str(files["garment"]), "--checkpoint",
+                                 str(files["checkpoint"]), "--out", str(out), "--duration", "0.2",
+                                 "--format", "obj,pc2", "--no-body"])
+    assert result.exit_code == 0, result.output
+    cache = read_point_cache(out / "skirt.pc2")
+    pos, _ = load_mesh(files["garment"])
+    assert cache.shape == (7, len(pos), 3)
+    rest, _ = load_mesh(out / "skirt_rest.obj")
+    np.testing.assert_allclose(rest, pos, atol=1e-6)
+    assert len(list((out / "skirt_obj").glob("garment_*.obj"))) == 7
+
+
+def test_centimetres_are_detected_and_refused_when_forced_to_metres(files) -> None:
+    result = runner.invoke(app, ["animate", str(files["cm"]), "--checkpoint",
+                                 str(files["checkpoint"]), "--out", str(files["folder"] / "x"),
+                                 "--fix-units", "m", "--duration", "0.1", "--format", "obj"])
+    assert result.exit_code == 2
+    assert "not on the rest body" in " ".join(result.output.split())
+    fixed = runner.invoke(app, ["animate", str(files["cm"]), "--checkpoint",
+                                str(files["checkpoint"]), "--out", str(files["folder"] / "y"),
+                                "--duration", "0.1", "--format", "obj", "--no-body"])
+    assert fixed.exit_code == 0, fixed.output
+
+
+def test_bad_inputs_exit_2(files, tmp_path: Path) -> None:
+    cases = [
+        (["animate", str(tmp_path / "absent.obj"), "--checkpoint", str(files["checkpoint"])],
+         "absent.obj: file not found"),
+        (["animate", str(files["garment"]), "--checkpoint", str(tmp_path / "none.pt")],
+         "none.pt: checkpoint not found"),
+        (["animate", str(files["garment"]), "--checkpoint", str(files["checkpoint"]),
+          "--motion", "moonwalk"], "--motion moonwalk"),
+        (["animate", str(files["garment"]), "--checkpoint", str(files["checkpoint"]),
+          "--body-shape", "giant"], "--body-shape giant"),
+    ]
+    for arguments, message in cases:
+        result = runner.invoke(app, arguments)
+        assert result.exit_code == 2, (arguments, result.output)
+        assert message in " ".join(result.output.split())
