@@ -161,13 +161,21 @@ def prepare_body(root: Path, plan: BodyPlan, config: DataConfig) -> None:
 
 def make_garment(design: DesignPlan, body: BodyPlan) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The design fitted to the body's rest pose: ``pos (N, 3)``, ``faces (F, 3)`` and the
-    indices of the vertices pinned to the pelvis (empty unless waist-supported)."""
-    from data_prep.garments import generate_garment
+    indices of the vertices pinned to the pelvis (empty unless waist-supported).
+
+    A design is its type, a style drawn from the design's seed and a resolution: the
+    same design on every body (fitted to each), as CLOTH3D refits a garment per body.
+    """
+    from data_prep.garments import GARMENT_TYPES, BodyFrame
+    from data_prep.garments import make_garment as build_garment
 
     rest = _body_model().rest(_shape(body))
-    garment = generate_garment(design.garment_type, rest.vertices.numpy(), rest.faces,
-                               rest.joints.numpy(), seed=design.seed,
-                               target_vertices=design.vertices)
+    frame = BodyFrame(vertices=rest.vertices.numpy(), faces=rest.faces,
+                      joints=rest.joints.numpy())
+    style = GARMENT_TYPES[design.garment_type][0].sample(np.random.default_rng(design.seed))
+    garment = build_garment(frame, design.garment_type, style,
+                            target_vertices=design.vertices, seed=design.seed,
+                            name=design.name)
     pinned = (np.asarray(garment.pin_candidates, dtype=np.int64)
               if design.garment_type in WAIST_SUPPORTED else np.zeros(0, dtype=np.int64))
     return garment.pos, garment.faces, pinned

@@ -386,16 +386,16 @@ def benchmark_accuracy(
     console.print(f"[green]wrote[/] {output}: {len(result['rows'])} rows")
 
 
-def _register_optional_commands() -> None:
-    """Commands of other subpackages register themselves here."""
-    try:
-        from gnngarment.body.commands import register as register_body
-    except ImportError:  # the body subpackage is optional until it lands
-        return
+def _register_subpackage_commands() -> None:
+    """``body``, ``motions`` and ``attribute`` live next to the code they drive."""
+    from gnngarment.attribution.commands import register as register_attribution
+    from gnngarment.body.commands import register as register_body
+
     register_body(app)
+    register_attribution(app)
 
 
-_register_optional_commands()
+_register_subpackage_commands()
 
 
 def main() -> None:

@@ -1,15 +1,18 @@
 """``make demo``: the main job end to end on the embedded default.
 
-What runs today (the pipeline grows with the library; see README "Status"):
-1. build an unseen procedural garment (an irregularly triangulated two-piece skirt
-   with a separate waistband) and write it as OBJ;
-2. prepare it as training and inference will: validate, 2-level structure-preserving
-   pooling hierarchy (Algorithm 1) with unpooling matrices (Algorithm 2), Nyström
-   style descriptor; save the hierarchy cache (.npz) and a JSON report;
-3. check the prepared data the way the model will use it: unpooling a constant field
-   through every level reproduces it, and every pooled level keeps the components.
+1. build the demo dataset: procedural garments on Anny bodies, motions from the
+   procedural library, ground truth simulated with NVIDIA Newton (``configs/data/demo.yaml``);
+2. train the small model briefly through both stages (``configs/train/demo.yaml``);
+3. evaluate it — and the shipped checkpoint — on held-out garments, bodies and motions;
+4. animate an unseen garment (a new design on a body shape not in the dataset) with the
+   shipped model and export OBJ/PC2/glb/GIF;
+5. write an integrated-gradients attribution heatmap of that garment.
 
-    python -m gnngarment.demo --out demo_output
+Everything lands in one folder (default ``demo_output/``) with ``summary.json``. Every
+stage resumes: the dataset build skips finished sequences, training resumes from its
+last checkpoint.
+
+    python -m gnngarment.demo --out demo_output [--quick]
 """
 
 from __future__ import annotations
@@ -18,92 +21,171 @@ import argparse
 import json
 import time
 from pathlib import Path
+from typing import Any
 
-import numpy as np
 from rich.console import Console
 from rich.table import Table
+
+from gnngarment.paths import REPOSITORY_ROOT, SHIPPED_MODEL
 
 console = Console()
 
 
-def two_piece_skirt(seed: int = 7) -> tuple[np.ndarray, np.ndarray]:
-    """A flared skirt plus a separate waistband ring: a garment of two components."""
-    from data_prep.garments import flared_skirt
-
-    skirt_pos, skirt_faces = flared_skirt(3000, waist_radius=0.16, hem_radius=0.42,
-                                          length=0.55, waist_height=-0.02, seed=seed)
-    band_pos, band_faces = flared_skirt(400, waist_radius=0.165, hem_radius=0.165,
-                                        length=0.04, waist_height=0.03, seed=seed + 1)
-    return (np.vstack([skirt_pos, band_pos]),
-            np.vstack([skirt_faces, band_faces + len(skirt_pos)]))
-
-
-def run(out: Path) -> dict:
+def unseen_garment(out: Path, seed: int = 20261123) -> tuple[Path, Any, Any]:
+    """A garment design that is in no dataset (its own seed), on a body shape that is in
+    no split (the "tall" phenotype below), written as OBJ. Returns the path, the body
+    model and the shape."""
     import trimesh
 
-    from gnngarment.geometry import (
-        connected_components,
-        load_mesh,
-        prepare_garment,
-    )
+    from data_prep.garments import BodyFrame, sample_garment
+    from gnngarment.body import AnnyBodyModel, AnnyShape
+
+    body_model = AnnyBodyModel()
+    shape = AnnyShape(gender=0.8, age=0.6, muscle=0.4, weight=0.35, height=0.7,
+                      proportions=0.5)
+    rest = body_model.rest(shape)
+    frame = BodyFrame(vertices=rest.vertices.numpy(), faces=rest.faces,
+                      joints=rest.joints.numpy())
+    garment = sample_garment(frame, seed, garment_type="dress", resolution=(1200, 1600))
+    path = out / "unseen_dress.obj"
+    trimesh.Trimesh(garment.pos, garment.faces, process=False).export(path)
+    return path, body_model, shape
+
+
+def run(out: Path, data_config: Path, train_config: Path, model_path: Path | None,
+        attribution_steps: int = 50, motion_seconds: float = 2.0,
+        workspace: Path | None = None) -> dict[str, Any]:
+    """The five stages; ``workspace`` (if given) replaces the configs' dataset and run
+    folders (``<workspace>/data``, ``<workspace>/run``)."""
+    from data_prep.build import build_dataset
+    from data_prep.config import DataConfig
+    from gnngarment.attribution.commands import run_attribution
+    from gnngarment.body import make_motion
+    from gnngarment.config import load_config
+    from gnngarment.data import PreparedDataset
+    from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs
+    from gnngarment.evaluation import evaluate, write_report
+    from gnngarment.geometry import load_mesh
+    from gnngarment.inference.animate import animate
+    from gnngarment.inference.export import export_animation
+    from gnngarment.training.checkpoint import load_model
+    from gnngarment.training.loading import load_training_config
+    from gnngarment.training.trainer import Trainer
 
     out.mkdir(parents=True, exist_ok=True)
-    summary: dict = {"files": {}}
+    seconds: dict[str, float] = {}
+    summary: dict[str, Any] = {"files": {}}
 
-    with console.status("building an unseen two-piece garment"):
-        pos, faces = two_piece_skirt()
-        garment_path = out / "garment.obj"
-        trimesh.Trimesh(pos, faces, process=False).export(garment_path)
+    started = time.perf_counter()
+    console.rule("1/5 dataset (Newton simulation)")
+    data = load_config(data_config, DataConfig)
+    if workspace is not None:
+        data.output = str(workspace / "data")
+    build = build_dataset(data, log=console.print)
+    seconds["dataset"] = time.perf_counter() - started
+    summary["dataset"] = {"folder": data.output, "splits": build["splits"],
+                          "left_out": len(build["failed_sequences"]),
+                          "seconds_per_frame": build["seconds_per_frame"]}
+
+    started = time.perf_counter()
+    console.rule("2/5 training (both stages)")
+    overrides = [f"data={data.output}"]
+    if workspace is not None:
+        overrides.append(f"output={workspace / 'run'}")
+    settings = load_training_config(train_config, overrides)
+    window = settings.model.window
+    trainer = Trainer(settings, PreparedDataset(data.output, "train", window),
+                      PreparedDataset(data.output, "val", window))
+    training = trainer.fit(resume=True)
+    seconds["training"] = time.perf_counter() - started
+    summary["training"] = {"epochs": training["epochs"], "switches": training["switches"],
+                           "checkpoint": str(trainer.checkpoint_path())}
+
+    started = time.perf_counter()
+    console.rule("3/5 evaluation on held-out garments, bodies and motions")
+    models = {"demo run": load_model(trainer.checkpoint_path())}
+    model_path = model_path or (SHIPPED_MODEL if SHIPPED_MODEL.is_file() else None)
+    if model_path is not None:
+        shipped = load_model(model_path)
+        if shipped.config.body_vertices == settings.model.body_vertices:
+            models["shipped"] = shipped
+    report = evaluate(models, PreparedDataset(data.output, "test", window))
+    write_report(report, out / "evaluation.md", out / "evaluation.json")
+    console.print(report.to_markdown())
+    seconds["evaluation"] = time.perf_counter() - started
+    summary["evaluation"] = {method: values["all"] for method, values in report.results.items()}
+    summary["files"]["evaluation"] = str(out / "evaluation.md")
+
+    started = time.perf_counter()
+    console.rule("4/5 animate an unseen garment")
+    animator = models.get("shipped", models["demo run"])
+    summary["animated_with"] = "shipped" if "shipped" in models else "demo run"
+    garment_path, body_model, shape = unseen_garment(out)
+    pos, faces = load_mesh(garment_path)
+    body = body_shape_inputs(body_model, shape, animator.config.body_vertices)
+    frames = body_motion_inputs(body_model, shape,
+                                make_motion("walk", duration=motion_seconds, seed=7),
+                                animator.config.body_vertices)
+    animation = animate(animator, pos, faces, body, frames, source=str(garment_path))
+    paths = export_animation(animation, out / "animation", garment_path.stem)
+    seconds["animation"] = time.perf_counter() - started
+    summary["animation"] = {"frames": int(animation.posed.shape[0]), "vertices": len(pos),
+                            "model_fps": animation.posed.shape[0] / animation.seconds["frames"]}
+    summary["files"] |= {key: str(path) for key, path in paths.items()}
     summary["files"]["garment"] = str(garment_path)
-    console.print(f"[green]1/3[/] garment written: {garment_path} "
-                  f"({len(pos)} vertices, {len(faces)} faces)")
 
-    with console.status("preparing: validation, pooling hierarchy, style descriptor"):
-        pos, faces = load_mesh(garment_path)  # the user's path: from the file, order kept
-        prepared = prepare_garment(pos, faces, source=str(garment_path))
-        hierarchy_path = out / "garment.hierarchy.npz"
-        prepared.hierarchy.save(hierarchy_path)
-    summary["files"]["hierarchy"] = str(hierarchy_path)
-    table = Table(title="2-level structure-preserving pooling")
-    for column in ("level", "vertices", "edges", "components"):
-        table.add_column(column)
-    edges_per_level = [prepared.edge_index] + [lv.edge_index for lv in prepared.hierarchy.levels]
-    for k, (n, e) in enumerate(zip(prepared.hierarchy.vertex_counts(),
-                                   prepared.hierarchy.edge_counts(), strict=True)):
-        components = int(connected_components(edges_per_level[k], n).max()) + 1
-        table.add_row(str(k), str(n), str(e), str(components))
-    console.print("[green]2/3[/] prepared in " + ", ".join(
-        f"{k} {v:.3f}s" for k, v in prepared.seconds.items()))
-    console.print(table)
-
-    field = np.ones((prepared.hierarchy.levels[-1].num_vertices, 1))
-    for level in reversed(prepared.hierarchy.levels):
-        field = level.unpool @ field
-    error = float(np.abs(field - 1).max())
-    console.print(f"[green]3/3[/] unpooling a constant through both levels: max error {error:.1e}")
-
-    summary |= {
-        "vertices": len(pos), "faces": len(faces),
-        "components": prepared.report.num_components,
-        "levels": prepared.hierarchy.vertex_counts(),
-        "descriptor_head": prepared.descriptor[:8].round(5).tolist(),
-        "constant_unpool_error": error,
-        "seconds": prepared.seconds,
-    }
-    report_path = out / "summary.json"
-    report_path.write_text(json.dumps(summary, indent=2))
+    started = time.perf_counter()
+    console.rule("5/5 attribution heatmap (integrated gradients, Gauss-Legendre)")
+    attribution = run_attribution(animator, pos, faces, body, frames, out / "attribution",
+                                  n_steps=attribution_steps, source=str(garment_path))
+    seconds["attribution"] = time.perf_counter() - started
+    summary["attribution"] = {k: v for k, v in attribution.items()
+                              if isinstance(v, (int, float, str))}
+    summary["files"]["heatmap"] = str(out / "attribution" / "attribution.png")
+    summary["seconds"] = seconds
+    (out / "summary.json").write_text(json.dumps(summary, indent=2, default=str))
     return summary
+
+
+def _print_summary(summary: dict[str, Any], out: Path, total: float) -> None:
+    table = Table(title="held-out test split (mean over frames)")
+    for column in ("method", "E_verts mm", "E_norm °", "collision %", "Hausdorff mm",
+                   "spurious mm"):
+        table.add_column(column)
+    for method, values in summary["evaluation"].items():
+        table.add_row(method, *(f"{values[k]:.1f}" for k in (
+            "e_verts_mm", "e_norm_deg", "collision_pct", "hausdorff_mm", "spurious_mm")))
+    console.print(table)
+    console.print(f"animated {summary['animation']['frames']} frames of an unseen "
+                  f"{summary['animation']['vertices']}-vertex dress with the "
+                  f"{summary['animated_with']} model "
+                  f"({summary['animation']['model_fps']:.1f} frames/s)")
+    console.print("seconds: " + ", ".join(f"{k} {v:.0f}" for k, v in summary["seconds"].items())
+                  + f"; total {total:.0f}")
+    console.print(f"[bold]outputs in {out}/[/]:")
+    for key in ("garment", "glb", "pc2", "obj", "gif", "heatmap", "evaluation"):
+        if key in summary["files"]:
+            console.print(f"  {key:10} {summary['files'][key]}")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description="Run the gnngarment demo end to end.")
     parser.add_argument("--out", type=Path, default=Path("demo_output"))
+    parser.add_argument("--quick", action="store_true",
+                        help="tiny dataset and run (what the tests use)")
+    parser.add_argument("--model", type=Path, default=None,
+                        help="checkpoint to animate with (default: the shipped one)")
     arguments = parser.parse_args()
-    start = time.perf_counter()
-    summary = run(arguments.out)
-    console.print(f"\n[bold]done in {time.perf_counter() - start:.1f}s[/]; outputs in "
-                  f"{arguments.out}/: " + ", ".join(Path(p).name for p in summary["files"].values())
-                  + ", summary.json")
+    configs = REPOSITORY_ROOT / "configs"
+    started = time.perf_counter()
+    if arguments.quick:
+        summary = run(arguments.out, configs / "data" / "tiny.yaml",
+                      configs / "train" / "tiny.yaml", arguments.model, attribution_steps=8,
+                      motion_seconds=0.5)
+    else:
+        summary = run(arguments.out, configs / "data" / "demo.yaml",
+                      configs / "train" / "demo.yaml", arguments.model)
+    _print_summary(summary, arguments.out, time.perf_counter() - started)
 
 
 if __name__ == "__main__":

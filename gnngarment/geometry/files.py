@@ -46,6 +46,8 @@ def atomic_write(path: str | Path, write: Callable[[BinaryIO], None]) -> Path:
             write(stream)
             stream.flush()
             os.fsync(stream.fileno())
+        if path.exists():  # replacing a file keeps its permissions, as an in-place write would
+            os.chmod(temp, path.stat().st_mode & 0o777)
         os.replace(temp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
