@@ -94,8 +94,9 @@ def run(out: Path, data_config: Path, train_config: Path, model_path: Path | Non
         overrides.append(f"output={workspace / 'run'}")
     settings = load_training_config(train_config, overrides)
     window = settings.model.window
+    validation = PreparedDataset(data.output, "val", window)
     trainer = Trainer(settings, PreparedDataset(data.output, "train", window),
-                      PreparedDataset(data.output, "val", window))
+                      validation if len(validation) else None)
     training = trainer.fit(resume=True)
     seconds["training"] = time.perf_counter() - started
     summary["training"] = {"epochs": training["epochs"], "switches": training["switches"],
