@@ -28,6 +28,9 @@ from gnngarment.model.motion_encoder import MotionEncoder
 from gnngarment.model.multilevel_processor import MultilevelProcessor
 from gnngarment.model.style_encoder import StyleEncoder
 
+#: Scale of the supervised submodule's initial output weights (see ``__init__``).
+OUTPUT_INIT_SCALE = 0.01
+
 #: Per-frame motion state: 24 axis-angles + root displacement (blueprint Eq. 6).
 MOTION_CHANNELS = 3 * (NUM_JOINTS + 1)
 
@@ -114,6 +117,12 @@ class GarmentDeformer(nn.Module):
                                        config.dropout)
 
         self.supervised_processor = processor()
+        # Blend shapes are corrections of centimetres: a Glorot-initialised output GAT
+        # predicts ~1 m offsets from the tanh features, which the first epochs would spend
+        # undoing. Scaled down, the untrained model starts near plain skinning while every
+        # layer still receives gradients.
+        with torch.no_grad():
+            self.supervised_processor.output.lin.weight.mul_(OUTPUT_INIT_SCALE)
         self.physics_processor = processor() if config.physics_submodule else None
         if self.physics_processor is not None:
             # The physics stage starts from the supervised solution: its submodule adds

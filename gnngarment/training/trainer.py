@@ -204,8 +204,8 @@ class Trainer:
             self.optimiser.step()
             self.global_step += 1
             count += 1
-            for name, value in terms.items():
-                sums[name] = sums.get(name, 0.0) + value
+            for name, term in terms.items():
+                sums[name] = sums.get(name, 0.0) + term
             sums["loss"] = sums.get("loss", 0.0) + value
             bar.set_postfix(loss=f"{value:.4g}")
         metrics = {name: value / max(count, 1) for name, value in sums.items()}
