@@ -31,6 +31,25 @@ from gnngarment.geometry.files import atomic_write, atomic_write_bytes
 BUILDER_VERSION = 1
 #: Garment types whose waist ring is pinned to the pelvis (they hang from the waist).
 WAIST_SUPPORTED = ("skirt", "trousers")
+#: A garment whose mean distance to the body exceeds this in any frame has slid off
+#: (the simulator's gates - NaN, stretch, penetration - do not see a garment falling).
+MAX_MEAN_BODY_DISTANCE = 0.15
+
+
+def left_the_body(positions: np.ndarray, body_points: np.ndarray,
+                  limit: float = MAX_MEAN_BODY_DISTANCE) -> str:
+    """Why a simulated garment is not worn any more, or ``""``.
+
+    Shapes: positions ``(T, N, 3)``, body_points ``(T, M, 3)`` (metres).
+    """
+    from scipy.spatial import cKDTree
+
+    for t in range(len(positions)):
+        distance = float(cKDTree(body_points[t]).query(positions[t])[0].mean())
+        if distance > limit:
+            return (f"garment slid off the body: mean distance {distance:.2f} m > {limit} m "
+                    f"at frame {t}")
+    return ""
 
 
 @dataclass(frozen=True)
@@ -249,6 +268,10 @@ def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[s
         samples = body_model.feature_vertex_indices(config.collision_points)
         normals = np.stack([vertex_normals(v, body_model.faces)[samples] for v in body_vertices])
         features = motion_features(motion).numpy()
+        off = left_the_body(result.positions, body_vertices[:, samples])
+        if off:
+            return {"name": plan.name, "ok": False, "reason": off,
+                    "seconds": time.perf_counter() - started}
         record = SequenceRecord(
             name=plan.name, garment=plan.garment, body=plan.body.name, motion=plan.motion.name,
             fps=config.fps, positions=result.positions, joint_transforms=transforms,
