@@ -1,9 +1,19 @@
-"""A flared skirt with an irregular triangulation, like garments exported from DCC tools."""
+"""Skirts: the body-fitted :class:`SkirtStyle` type, and the stand-alone
+:func:`flared_skirt` cone (no body needed; used by the demo and benchmarks)."""
 
 from __future__ import annotations
 
+import dataclasses
+from typing import ClassVar
+
 import numpy as np
 from scipy.spatial import Delaunay
+
+from data_prep.garments.blueprint import Blueprint
+from data_prep.garments.body_frame import BodyFrame
+from data_prep.garments.parts import bounds, hem_cut, hem_low, trunk_stack, waist_cut
+from data_prep.garments.shapes import Design
+from data_prep.garments.style import Style, number
 
 
 def flared_skirt(num_vertices: int = 2000, waist_radius: float = 0.15,
@@ -49,3 +59,37 @@ def flared_skirt(num_vertices: int = 2000, waist_radius: float = 0.15,
     # Delaunay triangles are counter-clockwise seen from +z; lifted onto the downward
     # cone they face outward, away from the body (checked in the tests).
     return pos[used], remap[faces].astype(np.int64)
+
+
+# ---- body-fitted skirt (the synthetic set's "skirt" type) ---------------------------
+
+
+@dataclasses.dataclass(frozen=True)
+class SkirtStyle(Style):
+    """A skirt: a tube from the waist down, widening below the hips."""
+
+    garment_type: ClassVar[str] = "skirt"
+    waist_height: float = number(0.5, 0.0, 1.0, "waistband height: 0 = hip joints, 1 = natural "
+                                 "waist")
+    length: float = number(0.4, 0.15, 0.9, "hem drop as a fraction of waist-to-ankle (mini → "
+                           "maxi)")
+    flare: float = number(0.3, 0.0, 0.6, "hem widening in metres per metre below the hips "
+                          "(0 = straight/pencil)")
+    looseness: float = number(0.02, 0.01, 0.045, "ease at the waist and hips (m)")
+    front_rise: float = number(0.0, -0.04, 0.1, "how much higher the hem is in front than at the "
+                               "back (m; high-low hem)")
+
+
+def skirt_blueprint(body: BodyFrame, style: SkirtStyle) -> Blueprint:
+    """The implicit skirt around ``body``: waist and hem cuts on a skirt stack."""
+    m = body.measurements
+    z_waist = m.z_hip + style.waist_height * (m.z_waist - m.z_hip)
+    z_hem = z_waist - style.length * (z_waist - (m.z_ankle + 0.06))
+    z_hem = min(z_hem, m.z_crotch - 0.06)  # a skirt covers the crotch
+    stack = trunk_stack(m, z_hem - 0.1, z_waist + 0.1, style.looseness,
+                        skirt_from=min(m.z_hip, z_waist - 0.02), flare=style.flare, cap=False,
+                        vertices=body.vertices)
+    design = Design(solids=[stack],
+                    cuts=[waist_cut(z_waist), hem_cut(z_hem, stack, front_rise=style.front_rise)],
+                    bounds=bounds([stack], hem_low(z_hem, style.front_rise), z_waist + 0.03))
+    return Blueprint(design=design, loops=2, top="waist")

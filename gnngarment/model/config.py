@@ -8,6 +8,11 @@ from dataclasses import dataclass, field
 #: pooling, or PyG's learned poolers (the paper's baselines).
 POOLING_METHODS = ("structure", "topk", "sag", "asap")
 
+#: Implementations of the GAT layers: ``csr`` (:class:`~gnngarment.model.graph_attention.
+#: GraphAttention`, edge softmax + one CSR matmul) or ``pyg`` (PyG's ``GATConv``, the
+#: reference). Both compute the same function with the same parameters.
+ATTENTION_IMPLEMENTATIONS = ("csr", "pyg")
+
 
 @dataclass
 class ModelConfig:
@@ -31,6 +36,7 @@ class ModelConfig:
         body_vertices: ``N_b'``, size of the body-vertex subset (E^bs input, E^t2 input/3).
         window: ``m``, frames of motion history seen by the LSTMs.
         dropout: attention dropout of the GATs (0 = none).
+        attention: one of :data:`ATTENTION_IMPLEMENTATIONS`; checkpoints load into either.
     """
 
     garment_channels: list[int] = field(default_factory=lambda: [32, 64, 128, 128])
@@ -49,6 +55,7 @@ class ModelConfig:
     body_vertices: int = 512
     window: int = 5
     dropout: float = 0.0
+    attention: str = "csr"
 
     @property
     def feature_channels(self) -> int:
@@ -73,6 +80,9 @@ class ModelConfig:
             raise ValueError(f"motion_hidden must equal F = {width}, got {self.motion_hidden}")
         if self.pooling not in POOLING_METHODS:
             raise ValueError(f"pooling must be one of {POOLING_METHODS}, got '{self.pooling}'")
+        if self.attention not in ATTENTION_IMPLEMENTATIONS:
+            raise ValueError(f"attention must be one of {ATTENTION_IMPLEMENTATIONS}, "
+                             f"got '{self.attention}'")
         if not 0 <= self.levels <= 6:
             raise ValueError(f"levels must be in 0..6, got {self.levels}")
         if not 0 < self.pooling_ratio < 1:

@@ -4,13 +4,14 @@ graph per level, as PyG's ``Batch`` does for one level."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
 import torch
 
 from gnngarment.geometry.hierarchy import PoolHierarchy
+from gnngarment.model.graph_attention import AttentionGraph, SparseOperator
 
 
 @dataclass
@@ -23,6 +24,11 @@ class GraphLevels:
         kept: per pooling step ``l -> l + 1``, ``(N_{l+1},)`` long indices into level ``l``.
         unpool: per pooling step, ``(N_l, N_{l+1})`` sparse (COO) unpooling operator.
         num_graphs: graphs in the batch.
+
+    The attention structure of every level (:meth:`attention_graph`) and the CSR form
+    of every unpooling operator (:meth:`unpool_operator`) are built on first use and
+    cached here, so all GAT layers of a level, both processors and every call with this
+    object share them.
     """
 
     edge_index: list[torch.Tensor]
@@ -30,10 +36,35 @@ class GraphLevels:
     kept: list[torch.Tensor]
     unpool: list[torch.Tensor]
     num_graphs: int
+    _attention: dict[int, tuple[torch.Tensor, AttentionGraph]] = field(
+        default_factory=dict, init=False, repr=False)
+    _unpool: dict[int, tuple[torch.Tensor, SparseOperator]] = field(
+        default_factory=dict, init=False, repr=False)
 
     @property
     def depth(self) -> int:
         return len(self.kept)
+
+    def attention_graph(self, level: int) -> AttentionGraph:
+        """The :class:`AttentionGraph` of ``edge_index[level]``: built once and cached
+        (rebuilt only if ``edge_index[level]`` was replaced, e.g. moved to a device)."""
+        edge_index = self.edge_index[level]
+        cached = self._attention.get(level)
+        if cached is None or cached[0] is not edge_index:
+            cached = (edge_index, AttentionGraph.from_edge_index(
+                edge_index, int(self.batch[level].shape[0])))
+            self._attention[level] = cached
+        return cached[1]
+
+    def unpool_operator(self, step: int) -> SparseOperator:
+        """``unpool[step]`` as a :class:`SparseOperator` (built once, cached like
+        :meth:`attention_graph`)."""
+        matrix = self.unpool[step]
+        cached = self._unpool.get(step)
+        if cached is None or cached[0] is not matrix:
+            cached = (matrix, SparseOperator(matrix))
+            self._unpool[step] = cached
+        return cached[1]
 
 
 def _to_torch_sparse(matrix: sp.spmatrix) -> torch.Tensor:

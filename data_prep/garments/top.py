@@ -1,0 +1,50 @@
+"""Tops: sleeveless (straps of any width, armholes) or strapless (a tube top)."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import ClassVar
+
+from data_prep.garments.blueprint import Blueprint
+from data_prep.garments.body_frame import BodyFrame
+from data_prep.garments.parts import bounds, hem_cut, trunk_stack, upper_parts
+from data_prep.garments.shapes import Design
+from data_prep.garments.style import Style, choice, number
+from data_prep.garments.tshirt import NECKLINES, hem_height
+
+
+@dataclasses.dataclass(frozen=True)
+class TopStyle(Style):
+    """A sleeveless top: tank top / camisole (straps) or tube top (strapless)."""
+
+    garment_type: ClassVar[str] = "top"
+    kind: str = choice("straps", ("straps", "strapless"), "shoulder straps or a straight top "
+                       "edge", weights=(3.0, 1.0))
+    length: float = number(0.5, 0.0, 1.0, "hem height: 0 = natural waist, 1 = 12 cm below the "
+                           "crotch")
+    looseness: float = number(0.025, 0.015, 0.06, "ease around the torso (m)")
+    strap: float = number(0.05, 0.025, 0.1, "shoulder strap width (m)")
+    armhole_drop: float = number(0.02, 0.0, 0.07, "armhole depth below the armpit (m)")
+    neckline: str = choice("round", NECKLINES, "neckline shape")
+    neck_depth: float = number(0.08, 0.03, 0.16, "neckline depth in front (m)")
+    back_depth: float = number(0.03, 0.005, 0.08, "neckline depth at the back (m)")
+    neck_width: float = number(0.02, 0.0, 0.05, "neckline width beyond the neck, each side (m)")
+    top_edge: float = number(0.04, 0.01, 0.1, "strapless: top edge below the armpits (m)")
+
+
+def top_blueprint(body: BodyFrame, style: TopStyle) -> Blueprint:
+    m = body.measurements
+    z_hem = hem_height(body, style.length)
+    torso = trunk_stack(m, z_hem - 0.1, float(m.shoulder_z.max()) + 0.1, style.looseness,
+                        skirt_from=m.z_hip if z_hem < m.z_hip else None,
+                        vertices=body.vertices)
+    sleeves = "strapless" if style.kind == "strapless" else "sleeveless"
+    extra, cuts, loops, top = upper_parts(
+        body.vertices, m, torso, sleeves=sleeves, sleeve_length=0.0, sleeve_looseness=0.0,
+        sleeve_flare=0.0, neckline=style.neckline, neck_depth=style.neck_depth,
+        back_depth=style.back_depth, neck_width=style.neck_width, strap=style.strap,
+        armhole_drop=style.armhole_drop, top_edge=style.top_edge)
+    solids = [torso, *extra]
+    design = Design(solids=solids, cuts=[hem_cut(z_hem, torso), *cuts],
+                    bounds=bounds(solids, z_hem - 0.03, float(m.shoulder_z.max()) + 0.15))
+    return Blueprint(design=design, loops=loops + 1, top=top)

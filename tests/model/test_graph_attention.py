@@ -1,0 +1,339 @@
+"""GraphAttention (edge softmax + CSR matmul) against PyG's GATConv, the reference."""
+
+from __future__ import annotations
+
+import pytest
+import torch
+from torch_geometric.nn import GATConv
+
+from gnngarment.geometry import edge_index_from_faces, pool_hierarchy
+from gnngarment.model import GarmentDeformer, MultilevelProcessor, stack_hierarchies
+from gnngarment.model.graph_attention import (
+    _MAX_SHIFT_GAP,
+    AttentionGraph,
+    GraphAttention,
+    SparseOperator,
+    _softmax_shift,
+    graph_attention,
+    set_attention,
+)
+from tests.meshes import random_disk, tube
+from tests.model.pairs import frame_inputs, make_pair, tiny_config
+
+TOLERANCE = dict(rtol=1e-5, atol=1e-6)
+
+
+def assert_relative(actual: torch.Tensor, expected: torch.Tensor, tolerance: float,
+                    name: str) -> None:
+    """``max |actual − expected| <= tolerance · max |expected|`` (normwise relative)."""
+    error = float((actual - expected).abs().max())
+    scale = float(expected.abs().max())
+    assert error <= tolerance * scale, f"{name}: {error:.2e} vs max {scale:.2e}"
+
+
+def random_graph(seed: int, num_nodes: int = 60, connected: int = 45, edges: int = 300
+                 ) -> torch.Tensor:
+    """Edges among the first ``connected`` nodes only (the rest are isolated), in two
+    components, with self loops and repeated edges (as a multigraph can have)."""
+    generator = torch.Generator().manual_seed(seed)
+    half = connected // 2
+    a = torch.randint(0, half, (2, edges // 2), generator=generator)
+    b = torch.randint(half, connected, (2, edges - edges // 2), generator=generator)
+    edge_index = torch.cat([a, b, a[:, :10]], dim=1)  # repeated edges
+    loops = torch.arange(0, connected, 7).repeat(2, 1)
+    return torch.cat([edge_index, loops], dim=1)
+
+
+def pair_of_layers(in_channels: int, out_channels: int, heads: int, concat: bool,
+                   seed: int = 0) -> tuple[GATConv, GraphAttention]:
+    torch.manual_seed(seed)
+    reference = GATConv(in_channels, out_channels, heads=heads, concat=concat)
+    torch.manual_seed(seed)
+    layer = GraphAttention(in_channels, out_channels, heads=heads, concat=concat)
+    with torch.no_grad():  # a non-zero bias, so that its gradient path is exercised too
+        reference.bias.normal_()
+        layer.bias.copy_(reference.bias)
+    return reference, layer
+
+
+def outputs_and_gradients(layer: torch.nn.Module, x: torch.Tensor, graph,
+                          weight: torch.Tensor) -> dict[str, torch.Tensor]:
+    x = x.clone().requires_grad_(True)
+    layer.zero_grad(set_to_none=True)
+    out = layer(x, graph)
+    (out * weight).sum().backward()
+    result = {"out": out.detach(), "x.grad": x.grad}
+    result.update({f"{name}.grad": p.grad for name, p in layer.named_parameters()})
+    return result
+
+
+@pytest.mark.parametrize("heads", [1, 4, 24])
+@pytest.mark.parametrize("concat", [True, False])
+@pytest.mark.parametrize("prebuilt", [True, False])
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+def test_outputs_and_gradients_equal_gatconv(heads: int, concat: bool, prebuilt: bool,
+                                             dtype: torch.dtype) -> None:
+    reference, layer = pair_of_layers(7, 5, heads, concat)
+    reference, layer = reference.to(dtype), layer.to(dtype)
+    edge_index = random_graph(seed=heads)
+    x = torch.randn(60, 7, generator=torch.Generator().manual_seed(1), dtype=dtype)
+    weight = torch.randn(60, 5 * heads if concat else 5, dtype=dtype,
+                         generator=torch.Generator().manual_seed(2))
+    graph = AttentionGraph.from_edge_index(edge_index, 60) if prebuilt else edge_index
+    expected = outputs_and_gradients(reference, x, edge_index, weight)
+    actual = outputs_and_gradients(layer, x, graph, weight)
+    assert expected.keys() == actual.keys()
+    for name in expected:
+        if dtype == torch.float64:  # the same function: equal to rounding, element-wise
+            torch.testing.assert_close(actual[name], expected[name], rtol=1e-5, atol=1e-12,
+                                       msg=name)
+        else:  # float32 sums in another order: relative to the tensor's magnitude
+            assert_relative(actual[name], expected[name], 1e-5, name)
+
+
+@pytest.mark.parametrize("scale", [1.0, 10.0, 30.0])
+def test_large_logits_keep_matching(scale: float) -> None:
+    # Scaled attention vectors spread the logits far beyond the cheap shift's accepted
+    # gap (scale 10: ~35, 30: ~105): the exact segment max must then be used, and
+    # nothing may underflow or overflow. Sums of near one-hot softmaxes round
+    # differently, so compare normwise.
+    reference, layer = pair_of_layers(6, 4, 4, concat=False)
+    with torch.no_grad():
+        for module in (reference, layer):
+            module.att_src.mul_(scale)
+            module.att_dst.mul_(scale)
+    edge_index = random_graph(seed=3)
+    x = torch.randn(60, 6, generator=torch.Generator().manual_seed(4))
+    weight = torch.randn(60, 4, generator=torch.Generator().manual_seed(5))
+    expected = outputs_and_gradients(reference, x, edge_index, weight)
+    actual = outputs_and_gradients(layer, x, edge_index, weight)
+    for name in expected:
+        assert torch.isfinite(actual[name]).all(), name
+        assert_relative(actual[name], expected[name], 1e-5, name)
+
+
+@pytest.mark.parametrize("case", ["none", "bound", "exact"])
+def test_softmax_shift_keeps_exp_in_range(case: str) -> None:
+    graph = AttentionGraph.from_edge_index(random_graph(seed=8), 60)
+    layout = graph.layout(3)
+    generator = torch.Generator().manual_seed(9)
+    a_src = torch.randn(60, 3, generator=generator)
+    a_dst = torch.randn(60, 3, generator=generator)
+    if case == "bound":   # large logits of small spread: shift by the cheap bound
+        a_src += 100
+    if case == "exact":   # widely spread logits: the exact segment max is needed
+        a_src *= 100
+        a_dst *= 100
+    logits = torch.nn.functional.leaky_relu(
+        a_src.reshape(-1)[layout.source_slot.long()]
+        + a_dst.reshape(-1)[layout.target_slot.long()], 0.2)
+    exact = torch.full((180,), -torch.inf).scatter_reduce(
+        0, layout.target_slot.long(), logits, "amax")
+    shift = _softmax_shift(torch.cat([a_src, a_dst, a_src + a_dst], dim=1), 3, layout, 0.2)
+    assert (shift is None) == (case == "none")
+    if shift is None:
+        assert exact.max() <= 60 and exact.min() >= -_MAX_SHIFT_GAP
+        return
+    assert (shift >= exact).all()                      # exp never overflows
+    assert (shift - exact).max() <= _MAX_SHIFT_GAP     # denominators stay >= e^-20
+    if case == "exact":
+        torch.testing.assert_close(shift, exact, rtol=0, atol=0)
+
+
+def test_inference_mode_equals_autograd_path() -> None:
+    _, layer = pair_of_layers(6, 4, 4, concat=True)
+    graph = AttentionGraph.from_edge_index(random_graph(seed=6), 60)
+    x = torch.randn(60, 6)
+    with torch.inference_mode():
+        fast = layer(x, graph)
+    torch.testing.assert_close(fast, layer(x, graph), rtol=0, atol=1e-6)
+
+
+@pytest.mark.parametrize("concat", [True, False])
+def test_inference_leaves_parameters_alone(concat: bool) -> None:
+    # The inference path writes into a bias-filled output: it must be a copy even for
+    # one node and one head.
+    _, layer = pair_of_layers(3, 2, 1, concat=concat)
+    before = {k: v.clone() for k, v in layer.state_dict().items()}
+    with torch.inference_mode():
+        layer(torch.randn(1, 3), torch.zeros(2, 0, dtype=torch.long))
+        layer(torch.randn(1, 3), torch.zeros(2, 0, dtype=torch.long))
+    for name, value in layer.state_dict().items():
+        assert torch.equal(value, before[name]), name
+
+
+def test_parameters_are_gatconvs() -> None:
+    for concat in (True, False):
+        reference, layer = pair_of_layers(6, 3, 4, concat, seed=7)
+        # Same names and shapes: checkpoints load either way.
+        assert list(reference.state_dict()) == list(layer.state_dict())
+        layer.load_state_dict(reference.state_dict())
+        reference.load_state_dict(layer.state_dict())
+        # Same initialisation, drawn in the same order: seeded models are identical.
+        torch.manual_seed(7)
+        fresh_reference = GATConv(6, 3, heads=4, concat=concat)
+        torch.manual_seed(7)
+        fresh = GraphAttention(6, 3, heads=4, concat=concat)
+        for (name, a), (_, b) in zip(fresh_reference.state_dict().items(),
+                                     fresh.state_dict().items(), strict=True):
+            assert torch.equal(a, b), name
+
+
+def test_block_diagonal_batch_equals_per_graph_runs() -> None:
+    _, layer = pair_of_layers(5, 4, 4, concat=False)
+    graphs = [random_graph(seed=s, num_nodes=n, connected=c)
+              for s, n, c in ((10, 30, 25), (11, 40, 40), (10, 30, 25))]
+    sizes = [30, 40, 30]
+    features = [torch.randn(n, 5) for n in sizes]
+    offsets = [0, 30, 70]
+    batched = AttentionGraph.from_edge_index(
+        torch.cat([g + o for g, o in zip(graphs, offsets, strict=True)], dim=1), sum(sizes))
+    together = layer(torch.cat(features), batched)
+    for g, x, o, n in zip(graphs, features, offsets, sizes, strict=True):
+        torch.testing.assert_close(together[o:o + n], layer(x, g), **TOLERANCE)
+
+
+def test_structure_round_trips_to_gatconv() -> None:
+    edge_index = random_graph(seed=12)
+    graph = AttentionGraph.from_edge_index(edge_index, 60)
+    assert graph.num_edges == (edge_index[0] != edge_index[1]).sum() + 60
+    reference, _ = pair_of_layers(4, 3, 2, concat=True)
+    x = torch.randn(60, 4)
+    torch.testing.assert_close(reference(x, graph.edge_index), reference(x, edge_index),
+                               **TOLERANCE)
+    assert graph.layout(2) is graph.layout(2)  # built once per head count
+
+
+def test_only_self_loops_and_bad_indices() -> None:
+    reference, layer = pair_of_layers(3, 2, 4, concat=True)
+    x = torch.randn(5, 3)
+    empty = torch.zeros(2, 0, dtype=torch.long)
+    torch.testing.assert_close(layer(x, empty), reference(x, empty), **TOLERANCE)
+    with pytest.raises(ValueError, match="outside"):
+        AttentionGraph.from_edge_index(torch.tensor([[0], [5]]), 5)
+    with pytest.raises(ValueError, match="nodes"):
+        layer(torch.randn(4, 3), AttentionGraph.from_edge_index(empty, 5))
+
+
+def test_dropout_only_in_training() -> None:
+    torch.manual_seed(0)
+    layer = GraphAttention(4, 3, heads=2, concat=True, dropout=0.5)
+    graph = AttentionGraph.from_edge_index(random_graph(seed=13), 60)
+    x = torch.randn(60, 4, requires_grad=True)
+    layer.eval()
+    assert torch.equal(layer(x, graph), layer(x, graph))
+    layer.train()
+    out = layer(x, graph)
+    assert not torch.allclose(out, layer(x, graph))
+    out.sum().backward()
+    assert x.grad is not None and torch.isfinite(x.grad).all()
+
+
+def test_bf16_autocast_keeps_attention_in_float32() -> None:
+    reference, layer = pair_of_layers(16, 8, 4, concat=False)
+    edge_index = random_graph(seed=14)
+    x = torch.randn(60, 16)
+    with torch.autocast("cpu", dtype=torch.bfloat16):
+        out = layer(x, edge_index)
+    assert out.dtype == torch.float32
+    torch.testing.assert_close(out, reference(x, edge_index), rtol=0, atol=0.05)
+
+
+def test_sparse_operator_matches_dense_product_and_gradient() -> None:
+    generator = torch.Generator().manual_seed(15)
+    dense_matrix = torch.rand(30, 20, generator=generator) * (torch.rand(30, 20) < 0.2)
+    operator = SparseOperator(dense_matrix.to_sparse())
+    x = torch.randn(20, 6, requires_grad=True)
+    out = operator @ x
+    torch.testing.assert_close(out, dense_matrix @ x)
+    weight = torch.randn(30, 6)
+    (out * weight).sum().backward()
+    torch.testing.assert_close(x.grad, dense_matrix.t() @ weight)
+
+
+def processors_both_ways(pooling: str, levels: int) -> tuple[MultilevelProcessor,
+                                                               MultilevelProcessor]:
+    torch.manual_seed(0)
+    csr = MultilevelProcessor(6, 8, 2, 3, 2, levels, pooling=pooling)
+    torch.manual_seed(0)
+    pyg = MultilevelProcessor(6, 8, 2, 3, 2, levels, pooling=pooling, attention="pyg")
+    assert all(isinstance(m, GATConv) for m in pyg.modules() if hasattr(m, "att_src"))
+    assert all(isinstance(m, GraphAttention) for m in csr.modules() if hasattr(m, "att_src"))
+    return csr, pyg
+
+
+@pytest.mark.parametrize("pooling,levels", [("structure", 0), ("structure", 2), ("topk", 2)])
+def test_processor_equals_its_pyg_reference(pooling: str, levels: int) -> None:
+    meshes = [random_disk(120, 2), tube(6, 9)]
+    hierarchies = [pool_hierarchy(edge_index_from_faces(f, len(p)), len(p), 2)
+                   for p, f in meshes]
+    graph = stack_hierarchies(hierarchies * 2, depth=levels)
+    n = graph.batch[0].shape[0]
+    csr, pyg = processors_both_ways(pooling, levels)
+    x = torch.randn(n, 6)
+    weight = torch.randn(n, 3)
+    expected = outputs_and_gradients(pyg, x, graph, weight)
+    actual = outputs_and_gradients(csr, x, graph, weight)
+    for name in expected:
+        torch.testing.assert_close(actual[name], expected[name], rtol=1e-4, atol=1e-5,
+                                   msg=name)
+    # Structures are built once per level and reused by every layer and call.
+    if pooling == "structure":
+        assert graph.attention_graph(0) is graph.attention_graph(0)
+    if pooling == "structure" and levels:
+        assert graph.unpool_operator(0) is graph.unpool_operator(0)
+
+
+def test_structures_cached_during_inference_serve_training() -> None:
+    # A context prepared for inference may later be trained on: its cached structures
+    # must not be inference tensors (autograd refuses to save those).
+    hierarchy = pool_hierarchy(edge_index_from_faces(tube(6, 9)[1], 54), 54, 2)
+    graph = stack_hierarchies([hierarchy] * 2, depth=2)
+    torch.manual_seed(0)
+    processor = MultilevelProcessor(4, 8, 2, 3, 2, 2)
+    x = torch.randn(108, 4)
+    with torch.inference_mode():
+        before = processor(x, graph)
+    x.requires_grad_(True)
+    after = processor(x, graph)
+    after.sum().backward()
+    torch.testing.assert_close(after.detach(), before, rtol=0, atol=1e-6)
+    assert x.grad is not None and x.grad.abs().sum() > 0
+
+
+def test_graph_levels_rebuild_a_replaced_level() -> None:
+    hierarchy = pool_hierarchy(edge_index_from_faces(tube(6, 9)[1], 54), 54, 1)
+    graph = stack_hierarchies([hierarchy], depth=1)
+    first = graph.attention_graph(0)
+    graph.edge_index[0] = graph.edge_index[0].clone()
+    assert graph.attention_graph(0) is not first
+
+
+def test_pyg_variant_of_the_deformer_equals_csr() -> None:
+    pos, faces = random_disk(150, 11)
+    outputs = {}
+    for attention in ("csr", "pyg"):
+        config = tiny_config(attention=attention)
+        torch.manual_seed(0)
+        model = GarmentDeformer(config)
+        # The deformer builds its layers from config.attention; set_attention makes sure
+        # (and keeps the weights, which are the same either way).
+        set_attention(model, config.attention)
+        kind = GATConv if attention == "pyg" else GraphAttention
+        layers = [m for m in model.modules() if hasattr(m, "att_src")]
+        assert layers and all(isinstance(m, kind) for m in layers)
+        model.use_physics = True
+        pair = make_pair(pos, faces, config)
+        out = model(model.prepare([pair]), *frame_inputs(config, 1, 2))
+        out.posed.sum().backward()
+        outputs[attention] = out
+    for name in ("weights", "blend_shapes", "posed"):
+        torch.testing.assert_close(getattr(outputs["csr"], name),
+                                   getattr(outputs["pyg"], name), rtol=1e-4, atol=1e-5)
+
+
+def test_unknown_attention_is_rejected() -> None:
+    with pytest.raises(ValueError, match="attention"):
+        graph_attention(4, 4, 2, concat=True, attention="dense")
+    with pytest.raises(ValueError, match="attention"):
+        GarmentDeformer(tiny_config(attention="dense"))
