@@ -311,7 +311,7 @@ class BodyDistance:
         The union's signed distance is the minimum over components. Distances are exact
         up to ``exact_below`` metres; beyond it they may overestimate (the query stops
         as soon as a point is known to be farther). A component is only queried for the
-        points whose distance to its bounding box is below the best value so far.
+        points inside its bounding box or closer to it than the best value so far.
         """
         points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         count = len(points)
@@ -322,7 +322,9 @@ class BodyDistance:
         order = np.argsort(lower, axis=1)
         for rank in range(len(self.components)):
             component_of = order[:, rank]
-            active = lower[np.arange(count), component_of] < distance
+            bound = lower[np.arange(count), component_of]
+            # A component can lower the value if it may be closer, or contain the point.
+            active = (bound < distance) | (bound == 0)
             if not active.any():
                 break
             for c in np.unique(component_of[active]):

@@ -92,7 +92,8 @@ def garment_problems(garment: Garment, body: BodyFrame, expected_openings: int |
     component); consistent orientation; every vertex a manifold disk or half-disk; a
     sphere with one hole per opening (Euler characteristic); the expected number of
     boundary loops; smallest angle ≥ 2°; normals facing away from the body; no vertex
-    inside the body or closer than ``clearance`` (metres); no self-intersection.
+    inside the body or closer than ``clearance`` (metres), no face centre or edge middle
+    inside it; no self-intersection.
     """
     from data_prep.garments.mesher import boundary_loops
     from gnngarment.geometry import check_mesh
@@ -136,6 +137,17 @@ def garment_problems(garment: Garment, body: BodyFrame, expected_openings: int |
     if (distance < clearance).any():
         problems.append(f"{int((distance < clearance).sum())} vertices closer than "
                         f"{clearance * 1000:.0f} mm to the body")
+    # Between the vertices too: no face centre or edge middle inside the body. The signed
+    # distance is 1-Lipschitz, so only faces with a vertex closer than their longest
+    # edge can have such a point inside.
+    corners = pos[faces]
+    longest = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
+    near = corners[distance[faces].min(axis=1) < longest]
+    between = np.concatenate([near.mean(axis=1),
+                              0.5 * (near + np.roll(near, 1, axis=1)).reshape(-1, 3)])
+    crossing, _ = body.distance.clearance(between, threshold=0.02)
+    if crossing.any():
+        problems.append(f"{int(crossing.sum())} face centres or edge middles inside the body")
     # Outward: vertex normals agree with the direction away from the closest body point.
     from gnngarment.geometry import vertex_normals
 

@@ -112,10 +112,6 @@ class BodyMeasurements:
     center_y: float  # the body's middle depth (the frontal plane of the sewing pattern)
     height: float
 
-    def shoulder_top(self, x: np.ndarray | float) -> np.ndarray:
-        """Height ``z`` of the top of the trunk at ``x`` (held beyond the measured range)."""
-        return np.interp(x, self.shoulder_x, self.shoulder_z)
-
 
 def _segment_distance(points: np.ndarray, chain: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Distance ``(P,)`` from points to a polyline ``(M, 3)`` and the arc length ``(P,)``

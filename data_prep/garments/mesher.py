@@ -86,6 +86,7 @@ def boundary_loops(faces: np.ndarray) -> list[np.ndarray]:
 
 
 GRID_DENSE = 0.002  # metres: pattern spacing at which seam/opening lengths are measured
+MIN_OPENING_EDGES = 4  # least edges of one panel's half of an opening
 
 
 def _lengths(points: np.ndarray) -> np.ndarray:
@@ -100,7 +101,9 @@ def _resample_run(sil: Silhouette, run: np.ndarray, side: int, edge: float) -> n
     dense = resample(run, _lengths(run), GRID_DENSE)
     length_3d = float(_lengths(lift_on_grid(sil, dense, np.full(len(dense), side))).sum())
     flat = _lengths(dense)
-    return resample(dense, flat, float(flat.sum()) / max(round(length_3d / edge), 1))
+    # Openings get at least four edges per panel: a loop of fewer collapses in relax.
+    least = 1 if side == 0 else MIN_OPENING_EDGES
+    return resample(dense, flat, float(flat.sum()) / max(round(length_3d / edge), least))
 
 
 def build_panels(design: Design, target_vertices: int,
@@ -161,9 +164,10 @@ def _curve_step(pos: np.ndarray, f: np.ndarray, gf: np.ndarray, cuts: list[objec
 
 def relax(design: Design, pos: np.ndarray, faces: np.ndarray, loops: list[np.ndarray],
           loop_cuts: list[object], iterations: int = 20, rate: float = 0.5,
-          margin: float = 0.0) -> np.ndarray:
+          margin: float = 0.0, settle: int = 3) -> np.ndarray:
     """Even out the mesh on the design's surface (see the module docstring).
 
+    ``iterations`` smoothing steps are followed by ``settle`` steps that only project.
     Interior vertices are kept at least ``margin`` metres inside every cut, so smoothing
     never drags one across an opening's rim (a fold where the loop is short, e.g. the
     cuff of a thin sleeve on a coarse mesh).
@@ -183,22 +187,25 @@ def relax(design: Design, pos: np.ndarray, faces: np.ndarray, loops: list[np.nda
     on_loop = np.zeros(n, dtype=bool)
     on_loop[loop_vertices] = True
     interior = np.flatnonzero(~on_loop)
-    for step in range(iterations + 4):
+    for step in range(iterations + settle):
         value, grad = design.field_and_gradient(pos)
         newton = _clamp(-value[:, None] * grad
                         / np.maximum((grad**2).sum(axis=1), 1e-12)[:, None])
-        curve = _curve_step(pos[loop_vertices], value[loop_vertices], grad[loop_vertices],
-                            list(loop_cuts), cut_of)
-        if step < iterations:  # smooth, then (last four rounds) only project
+        rim = pos[loop_vertices]
+        if step < iterations:  # smooth, then (the last ``settle`` rounds) only project
             normal = grad / np.maximum(np.linalg.norm(grad, axis=1, keepdims=True), 1e-12)
             delta = matrix @ pos / degree[:, None] - pos
             delta -= (delta * normal).sum(axis=1, keepdims=True) * normal
-            along = 0.5 * (pos[before] + pos[after]) - pos[loop_vertices]
             moved = pos + rate * delta + newton
-            moved[loop_vertices] = pos[loop_vertices] + rate * along + curve
+            # Loop vertices slide along their loop, then go back onto its curve (the
+            # step is taken where they landed: a short loop would otherwise shrink).
+            rim = rim + rate * (0.5 * (pos[before] + pos[after]) - rim)
         else:
             moved = pos + newton
-            moved[loop_vertices] = pos[loop_vertices] + curve
+        for _ in range(2):
+            rim_value, rim_grad = design.field_and_gradient(rim)
+            rim = rim + _curve_step(rim, rim_value, rim_grad, list(loop_cuts), cut_of)
+        moved[loop_vertices] = rim
         pos = moved
         if margin > 0:
             pos[interior] = _keep_inside(design, pos[interior], margin)
@@ -247,7 +254,7 @@ def push_out(pos: np.ndarray, faces: np.ndarray, body: BodyDistance, clearance: 
 
 def mesh_design(design: Design, body: BodyDistance, target_vertices: int,
                 rng: np.random.Generator, clearance: float = 0.01,
-                iterations: int = 40) -> GarmentMesh:
+                iterations: int = 20) -> GarmentMesh:
     """Mesh a design around a body: pattern, lift, relax, push out (module docstring).
 
     Args:
@@ -274,7 +281,8 @@ def mesh_design(design: Design, body: BodyDistance, target_vertices: int,
     # changed (a sliver along a loop cannot be flipped, only moved).
     rounds = (iterations * 2 // 5, iterations * 2 // 5, iterations - 4 * (iterations // 5))
     for index, count in enumerate(rounds):
-        pos = relax(design, pos, faces, loops, loop_cuts, iterations=count, margin=0.25 * edge)
+        pos = relax(design, pos, faces, loops, loop_cuts, iterations=count, margin=0.25 * edge,
+                    settle=3 if index == 2 else 0)
         if index < 2:
             faces = delaunay_flips(pos, faces)
     pos, _ = push_out(pos, faces, body, clearance)

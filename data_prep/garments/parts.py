@@ -161,9 +161,9 @@ def sleeve(m: BodyMeasurements, side: str, length: float, looseness: float,
     """
     arm = m.arms[side]
     t_cut = length * arm.length
-    # Samples every 4 cm so the tube follows the arm's radius (deltoid, elbow, wrist).
-    t = np.unique(np.concatenate([np.arange(0.0, t_cut, 0.04), [t_cut, t_cut + 0.06],
-                                  arm.axis_t[(arm.axis_t > 0) & (arm.axis_t < t_cut)]]))
+    # The radius sampled every 2 cm, so the tube follows the arm (deltoid, elbow, wrist),
+    # held constant past the cuff; the axis is the bone chain up to 6 cm past the cuff.
+    t = np.arange(0.0, t_cut + 0.06, 0.02)
     # The measured radius near the shoulder joint includes the top of the shoulder
     # (which the torso's cap already covers): limit it to 1.2 × the radius 8 cm out.
     arm_radius = np.minimum(arm.radius_at(np.minimum(t, t_cut)),
@@ -171,7 +171,9 @@ def sleeve(m: BodyMeasurements, side: str, length: float, looseness: float,
     radius = arm_radius + looseness + flare * np.minimum(t, t_cut)
     cut = DiskCut(f"cuff_{side}", point=arm.point(t_cut), normal=-arm.direction(t_cut),
                   radius=float(radius[-1]) + 0.04)
-    return Tube(axis=arm.point(t), radius=radius), cut
+    bones = arm.axis_t[(arm.axis_t > 0) & (arm.axis_t < t_cut + 0.06)]
+    axis = arm.point(np.concatenate([[0.0], bones, [t_cut + 0.06]]))
+    return Tube(axis=axis, t=t, radius=radius), cut
 
 
 def neck_cut(m: BodyMeasurements, torso: Stack, *, front_depth: float, back_depth: float,

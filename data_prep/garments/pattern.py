@@ -135,21 +135,14 @@ def _crossings(values: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return result[0], result[1], fold_y
 
 
-def lift(design: Design, xz: np.ndarray, side: np.ndarray, ys: np.ndarray) -> np.ndarray:
-    """Place pattern points on the design's surface: ``(P, 3)``.
-
-    ``side`` ``(P,)`` is −1 (front panel: the first crossing coming from −Y), +1 (back
-    panel) or 0 (seam: the fold, where the solid is thinnest along Y). A point whose
-    line misses the solid goes to the fold.
-    """
-    front, back, fold = _crossings(_along_y(design, xz, ys), ys)
-    y = np.where(side < 0, front, np.where(side > 0, back, fold))
-    return np.stack([xz[:, 0], y, xz[:, 1]], axis=1)
-
-
 def lift_on_grid(sil: Silhouette, xz: np.ndarray, side: np.ndarray) -> np.ndarray:
-    """Like :func:`lift` but interpolating the silhouette's depth maps bilinearly: no
-    field evaluation, and accurate enough for a start that :mod:`.mesher` relaxes."""
+    """Place pattern points on the design's surface: ``(P, 3)``, by bilinear
+    interpolation of the silhouette's depth maps (no field evaluation; accurate enough
+    for a start that :mod:`.mesher` relaxes).
+
+    ``side`` ``(P,)`` is −1 (front panel: where the surface is first met coming from
+    −Y), +1 (back panel) or 0 (seam: the fold, where the solid is thinnest along Y).
+    """
     from scipy.ndimage import map_coordinates
 
     rows = (xz[:, 1] - sil.z[0]) / (sil.z[1] - sil.z[0])

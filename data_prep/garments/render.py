@@ -26,14 +26,17 @@ def view_rotation(azimuth_deg: float = 20.0, elevation_deg: float = 10.0) -> np.
 def draw_meshes(ax: Any, meshes: list[tuple[np.ndarray, np.ndarray, tuple[float, float, float],
                                              float]],
                 azimuth_deg: float = 20.0, elevation_deg: float = 10.0,
-                edge_color: Any = None, edge_width: float = 0.0) -> None:
+                edge_color: Any = None, edge_width: float = 0.0, flat: tuple[int, ...] = ()
+                ) -> None:
     """Draw triangle meshes on a 2D matplotlib axis.
 
     Args:
         ax: a matplotlib ``Axes``.
         meshes: ``(pos (N, 3), faces (F, 3), rgb, alpha)`` per mesh; each face is lit by
-            a headlight (two-sided, so the inside of an opening shows darker).
+            a light over the viewer's shoulder (two-sided, so the inside of an opening
+            shows darker).
         edge_color, edge_width: optional wireframe over the first mesh only.
+        flat: indices of meshes drawn unlit, in one colour (a silhouette).
     """
     from matplotlib.collections import PolyCollection
 
@@ -49,6 +52,8 @@ def draw_meshes(ax: Any, meshes: list[tuple[np.ndarray, np.ndarray, tuple[float,
         facing = normal[:, 2] >= 0
         shade = np.abs(normal @ light)
         shade = np.where(facing, 0.35 + 0.65 * shade, 0.2 + 0.35 * shade)
+        if index in flat:
+            shade = np.ones_like(shade)
         color = np.clip(np.asarray(rgb)[None, :] * shade[:, None], 0, 1)
         polygons.append(corners[:, :, :2])
         colors.append(np.concatenate([color, np.full((len(color), 1), alpha)], axis=1))

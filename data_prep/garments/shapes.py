@@ -186,8 +186,9 @@ class Stack:
 
 @dataclasses.dataclass
 class Tube:
-    """A tube around a polyline axis (a sleeve): ``axis (M, 3)``, radius ``(M,)`` at
-    each axis point, linear in between (metres).
+    """A tube around a polyline axis (a sleeve along the arm's bones): ``axis (M, 3)``,
+    and its radius ``radius (K,)`` at arc lengths ``t (K,)`` along the axis (metres;
+    piecewise linear, held beyond the ends).
 
     Points farther than ``reach`` from the tube's bounding box get the box distance
     instead of the exact value: it is a positive lower bound, so the zero set of any
@@ -195,12 +196,16 @@ class Tube:
     """
 
     axis: np.ndarray
+    t: np.ndarray
     radius: np.ndarray
     reach: float = 0.08
 
     def __post_init__(self) -> None:
         grow = float(np.max(self.radius)) + self.reach
         self._box = (self.axis.min(axis=0) - grow, self.axis.max(axis=0) + grow)
+        self._radius = UniformTable(self.t, self.radius)
+        lengths = np.linalg.norm(np.diff(self.axis, axis=0), axis=1)
+        self._start_t = np.concatenate([[0.0], np.cumsum(lengths)])
 
     def __call__(self, points: np.ndarray) -> np.ndarray:
         """Field ``(P,)`` at ``points (P, 3)``: negative inside."""
@@ -215,30 +220,35 @@ class Tube:
         grad = -gap / np.maximum(gap_length, 1e-12)[:, None] if gradient else None
         near = np.flatnonzero(gap_length == 0)
         p = points[near]
+        # The closest point on the polyline: per segment, keep the nearest.
         best = np.full(len(p), np.inf)
-        best_grad = np.zeros((len(p), 3))
+        arc = np.zeros(len(p))
+        offset_best = np.zeros((len(p), 3))
+        direction = np.zeros((len(p), 3))
+        inside = np.zeros(len(p), dtype=bool)
         for i in range(len(self.axis) - 1):
             start, segment = self.axis[i], self.axis[i + 1] - self.axis[i]
             length2 = float(segment @ segment)
             relative = p - start
             raw = relative @ segment / length2
-            t = np.clip(raw, 0.0, 1.0)
-            offset = relative - t[:, None] * segment
-            distance = np.sqrt(np.einsum("ij,ij->i", offset, offset))
-            slope = self.radius[i + 1] - self.radius[i]
-            value = distance - (self.radius[i] + t * slope)
-            better = value < best
-            best = np.where(better, value, best)
-            if gradient:
-                unit = offset / np.maximum(distance, 1e-12)[:, None]
-                # The radius only varies with t inside the segment.
-                inner = ((raw > 0) & (raw < 1))[:, None]
-                g = unit - np.where(inner, slope * segment[None, :] / length2, 0.0)
-                best_grad = np.where(better[:, None], g, best_grad)
-        result[near] = best
+            u = np.clip(raw, 0.0, 1.0)
+            offset = relative - u[:, None] * segment
+            distance2 = np.einsum("ij,ij->i", offset, offset)
+            better = distance2 < best
+            best = np.where(better, distance2, best)
+            arc = np.where(better, self._start_t[i] + u * np.sqrt(length2), arc)
+            offset_best[better] = offset[better]
+            direction[better] = segment / np.sqrt(length2)
+            inside = np.where(better, (raw > 0) & (raw < 1), inside)
+        distance = np.sqrt(best)
+        radius, slope = self._radius.with_slope(arc, slopes=gradient)
+        result[near] = distance - radius[0]
         if gradient:
-            assert grad is not None
-            grad[near] = best_grad
+            assert grad is not None and slope is not None
+            unit = offset_best / np.maximum(distance, 1e-12)[:, None]
+            # The radius varies with the arc length, which moves with the point only
+            # while its projection is inside a segment.
+            grad[near] = unit - np.where(inside, slope[0], 0.0)[:, None] * direction
         return result, grad
 
 

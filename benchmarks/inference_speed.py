@@ -1,0 +1,500 @@
+"""Inference speed of the garment deformer on CPU, and its ratio to the simulator.
+
+For ``configs/model/small.yaml`` and ``configs/model/paper.yaml`` on a ~5k-vertex flared
+skirt (one garment–body pair, context prepared once), prints frames/s of the full
+per-frame model (both LSTMs, both M^mp submodules, skinning; ``use_physics=True`` as
+deployed) at each batch size under ``torch.inference_mode``, for both GAT
+implementations (``csr``: GraphAttention, ``pyg``: GATConv), with:
+
+* the peak resident memory of the measuring process (each config × implementation runs
+  in its own child process, so its peak is its own);
+* the csr runs with glibc's default malloc and with ``MALLOC_TUNED`` (large freed blocks
+  kept for reuse instead of unmapped: fresh multi-MB tensors otherwise pay page faults);
+* where the time goes (LSTMs, processors, skinning, the rest) and the top operators;
+* bf16 autocast (whole forward, and processors only): speed, the error of the posed
+  vertices against float32 (max / mean, mm) and M^mp's relative error on unit-normal
+  inputs. ``small`` uses the shipped trained checkpoint (``models/gnngarment-small.pt``,
+  same network), ``paper`` freshly initialised weights;
+* the Newton simulator's frames/s on the same skirt around a moving capsule, and the
+  model ÷ simulator ratio.
+
+    .venv/bin/python benchmarks/inference_speed.py [--vertices 5000] [--configs small paper]
+        [--batches 1 16] [--attention csr pyg] [--malloc both] [--repeats 5] [--threads 1 2]
+        [--no-bf16] [--no-simulator] [--sim-frames 30]
+
+Timings are the best of ``--repeats`` runs after a warm-up run (the warm-up builds the
+cached graph structures): other processes share this machine's two cores.
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+import os
+import resource
+import subprocess
+import sys
+import time
+from collections import defaultdict
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
+import torch
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from data_prep.garments.skirt import flared_skirt  # noqa: E402
+from gnngarment.config import load_config  # noqa: E402
+from gnngarment.geometry import GarmentPreparationConfig, prepare_garment  # noqa: E402
+from gnngarment.model import (  # noqa: E402
+    GarmentBodyPair,
+    GarmentDeformer,
+    ModelConfig,
+    garment_vertex_features,
+    stack_hierarchies,
+)
+from gnngarment.model import deformer as deformer_module  # noqa: E402
+from gnngarment.model.graph_attention import set_attention  # noqa: E402
+
+#: glibc settings that keep freed large blocks in the heap: by default every tensor
+#: over 128 KiB is mmap'ed and unmapped again, so each large temporary pays page faults
+#: on first touch, which on this machine cost more than the arithmetic on it.
+MALLOC_TUNED = {"MALLOC_MMAP_THRESHOLD_": str(2**40), "MALLOC_TRIM_THRESHOLD_": str(2**40)}
+
+#: Components timed separately (attribute names of GarmentDeformer).
+COMPONENTS = ("pose_encoder", "velocity_encoder", "supervised_processor", "physics_processor")
+
+
+def make_pair(pos: np.ndarray, faces: np.ndarray, config: ModelConfig,
+              seed: int = 0) -> GarmentBodyPair:
+    """A garment–body pair as ``tests/model/pairs.make_pair`` builds it (synthetic joints
+    and body distances: only shapes matter for speed)."""
+    rng = np.random.default_rng(seed)
+    joints = rng.normal(scale=0.3, size=(24, 3))
+    prepared = prepare_garment(pos, faces, GarmentPreparationConfig(
+        levels=config.levels, landmarks=config.landmarks))
+    return GarmentBodyPair(
+        rest_pos=torch.tensor(pos, dtype=torch.float32),
+        features=torch.from_numpy(garment_vertex_features(pos, faces, joints)),
+        hierarchy=prepared.hierarchy,
+        descriptor=torch.tensor(prepared.descriptor, dtype=torch.float32),
+        body_distances=torch.tensor(rng.random((config.body_vertices, 24)),
+                                    dtype=torch.float32))
+
+
+def frame_inputs(config: ModelConfig, frames: int, seed: int = 0
+                 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Random motion / velocity windows and rigid joint transforms for one pair.
+
+    Shapes: ``(1, B, m, 75)``, ``(1, B, m, 3 N_b')``, ``(1, B, 24, 4, 4)``.
+    """
+    generator = torch.Generator().manual_seed(seed)
+    motion = torch.randn(1, frames, config.window, 75, generator=generator) * 0.2
+    velocity = torch.randn(1, frames, config.window, 3 * config.body_vertices,
+                           generator=generator) * 0.1
+    transforms = torch.eye(4).repeat(1, frames, 24, 1, 1)
+    angle = torch.rand(1, frames, 24, generator=generator)
+    transforms[..., 0, 0] = torch.cos(angle)
+    transforms[..., 0, 1] = -torch.sin(angle)
+    transforms[..., 1, 0] = torch.sin(angle)
+    transforms[..., 1, 1] = torch.cos(angle)
+    transforms[..., :3, 3] = torch.randn(1, frames, 24, 3, generator=generator) * 0.05
+    return motion, velocity, transforms
+
+
+def peak_rss_mb() -> float:
+    """Peak resident set size of this process [MB] (Linux reports KiB)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+class ComponentTimer:
+    """Wall time spent in the deformers' LSTMs, processors and skinning, per forward.
+
+    Forward hooks on the submodules of every model given to :meth:`attach`; skinning by
+    wrapping the ``skin`` the deformer module calls. One timer serves all models: runs
+    are sequential, and :meth:`reset` starts a new one.
+    """
+
+    def __init__(self) -> None:
+        self.seconds: dict[str, float] = defaultdict(float)
+        self._start: dict[str, float] = {}
+        original = deformer_module.skin
+
+        def timed_skin(*args, **kwargs):
+            tic = time.perf_counter()
+            out = original(*args, **kwargs)
+            self.seconds["skinning"] += time.perf_counter() - tic
+            return out
+
+        deformer_module.skin = timed_skin
+
+    def attach(self, model: GarmentDeformer) -> None:
+        for name in COMPONENTS:
+            module = getattr(model, name)
+            if module is not None:
+                module.register_forward_pre_hook(self._pre(name))
+                module.register_forward_hook(self._post(name))
+
+    def _pre(self, name: str) -> Callable:
+        def hook(module, inputs) -> None:
+            self._start[name] = time.perf_counter()
+        return hook
+
+    def _post(self, name: str) -> Callable:
+        def hook(module, inputs, output) -> None:
+            self.seconds[name] += time.perf_counter() - self._start[name]
+        return hook
+
+    def reset(self) -> None:
+        self.seconds.clear()
+
+
+@contextmanager
+def bf16_processors(model: GarmentDeformer) -> Iterator[None]:
+    """bf16 autocast inside the two M^mp submodules only (everything else float32)."""
+    originals = {}
+    for name in ("supervised_processor", "physics_processor"):
+        module = getattr(model, name)
+        if module is None:
+            continue
+        originals[name] = module.forward
+
+        def forward(*args, _original=module.forward, **kwargs):
+            with torch.autocast("cpu", dtype=torch.bfloat16):
+                return _original(*args, **kwargs).float()
+        module.forward = forward
+    try:
+        yield
+    finally:
+        for name, forward in originals.items():
+            getattr(model, name).forward = forward
+
+
+def time_interleaved(runs: dict[str, Callable[[], torch.Tensor]], repeats: int,
+                     timer: ComponentTimer) -> dict[str, dict]:
+    """Time several variants round-robin (so that they share the machine's load):
+    one warm-up each, then ``repeats`` rounds. Per variant: best and median wall time,
+    the component times of its best run, its output, and the process's peak RSS right
+    after its warm-up (a high-water mark: it includes the variants warmed up before)."""
+    outputs, rss = {}, {}
+    for name, run in runs.items():
+        outputs[name] = run()
+        rss[name] = peak_rss_mb()
+    times: dict[str, list[float]] = defaultdict(list)
+    parts: dict[str, list[dict[str, float]]] = defaultdict(list)
+    for _ in range(repeats):
+        for name, run in runs.items():
+            timer.reset()
+            tic = time.perf_counter()
+            run()
+            times[name].append(time.perf_counter() - tic)
+            parts[name].append(dict(timer.seconds))
+    result = {}
+    for name in runs:
+        best = int(np.argmin(times[name]))
+        result[name] = {"best_s": times[name][best], "median_s": float(np.median(times[name])),
+                        "parts": parts[name][best], "out": outputs[name],
+                        "peak_rss_mb": rss[name]}
+    return result
+
+
+def processor_bf16_error(model: GarmentDeformer, pair: GarmentBodyPair, frames: int) -> float:
+    """``max |M^mp_bf16(x) − M^mp(x)| / max |M^mp(x)|`` for unit-normal inputs ``x``.
+
+    Freshly initialised, the deformer's own processor inputs are tiny and its blend
+    shapes ~1e-8 m, so the posed-vertex error says nothing about bf16 in M^mp; this
+    relative error does (multiply by a trained model's blend-shape scale).
+    """
+    config = model.config
+    graph = stack_hierarchies([pair.hierarchy] * frames, config.levels)
+    processor = model.supervised_processor
+    generator = torch.Generator().manual_seed(0)
+    x = torch.randn(frames * pair.rest_pos.shape[0], config.feature_channels * 24,
+                    generator=generator)
+    reference = processor(x, graph)
+    with torch.autocast("cpu", dtype=torch.bfloat16):
+        low = processor(x, graph).float()
+    return float((low - reference).abs().max() / reference.abs().max())
+
+
+def initial_model(config: ModelConfig, args: argparse.Namespace
+                  ) -> tuple[GarmentDeformer, str]:
+    """The trained checkpoint when its network is this config's (realistic activations
+    and blend shapes for the bf16 error), else freshly initialised weights (seed 0)."""
+    path = Path(args.checkpoint) if args.checkpoint else None
+    if path is not None and path.is_file():
+        from gnngarment.training.checkpoint import load_model
+
+        model = load_model(path)
+        ours, theirs = asdict(model.config), asdict(config)
+        ours.pop("attention", None)
+        theirs.pop("attention", None)
+        if ours == theirs:
+            return set_attention(model, config.attention).eval(), path.name
+    torch.manual_seed(0)
+    return GarmentDeformer(config).eval(), "random init"
+
+
+def child(args: argparse.Namespace) -> None:
+    """Measure one config at one thread count, every implementation in ``--impl``
+    interleaved; print one JSON line per implementation."""
+    threads = args.threads[0]
+    torch.set_num_threads(threads)
+    config = load_config(ROOT / "configs" / "model" / f"{args.config}.yaml", ModelConfig)
+    pos, faces = flared_skirt(args.vertices)
+    pair = make_pair(pos, faces, config)
+    base, weights = initial_model(config, args)
+    base.use_physics = True
+    timer = ComponentTimer()
+    models, contexts, results = {}, {}, {}
+    with torch.inference_mode():
+        for impl in args.impl:
+            models[impl] = set_attention(copy.deepcopy(base), impl)  # same weights
+            timer.attach(models[impl])
+            tic = time.perf_counter()
+            contexts[impl] = models[impl].prepare([pair])
+            results[impl] = {"config": args.config, "attention": impl, "vertices": len(pos),
+                             "threads": threads, "weights": weights,
+                             "prepare_s": time.perf_counter() - tic,
+                             "rss_after_prepare_mb": peak_rss_mb(), "batches": {}}
+        for frames in args.batches:
+            inputs = frame_inputs(config, frames)
+            runs: dict[str, Callable[[], torch.Tensor]] = {
+                impl: (lambda m=models[impl], c=contexts[impl], i=inputs: m(c, *i).posed)
+                for impl in args.impl}
+            if args.bf16 and "csr" in models:
+                model, context = models["csr"], contexts["csr"]
+
+                def whole(m=model, c=context, i=inputs) -> torch.Tensor:
+                    with torch.autocast("cpu", dtype=torch.bfloat16):
+                        return m(c, *i).posed.float()
+
+                def processors(m=model, c=context, i=inputs) -> torch.Tensor:
+                    with bf16_processors(m):
+                        return m(c, *i).posed
+
+                runs["bf16"], runs["bf16_processors"] = whole, processors
+            timed = time_interleaved(runs, args.repeats, timer)
+            for impl in args.impl:
+                entry = {k: v for k, v in timed[impl].items() if k != "out"}
+                if impl != args.impl[0]:
+                    entry["max_diff_vs_" + args.impl[0]] = float(
+                        (timed[impl]["out"] - timed[args.impl[0]]["out"]).abs().max())
+                results[impl]["batches"][str(frames)] = entry
+            for mode in ("bf16", "bf16_processors"):
+                if mode in timed:
+                    error = (timed[mode]["out"] - timed["csr"]["out"]).abs() * 1000  # mm
+                    results["csr"]["batches"][str(frames)][mode] = {
+                        "best_s": timed[mode]["best_s"], "max_mm": float(error.max()),
+                        "mean_mm": float(error.mean()),
+                        "processor_rel": processor_bf16_error(models["csr"], pair, frames)}
+        if args.profile_batch in args.batches and "csr" in models:
+            from torch.profiler import ProfilerActivity, profile
+            inputs = frame_inputs(config, args.profile_batch)
+            with profile(activities=[ProfilerActivity.CPU]) as prof:
+                models["csr"](contexts["csr"], *inputs)
+            results["csr"]["profile"] = prof.key_averages().table(
+                sort_by="self_cpu_time_total", row_limit=12)
+    for result in results.values():
+        print("RESULT " + json.dumps(result))
+
+
+def measure_simulator(pos: np.ndarray, faces: np.ndarray, frames: int) -> float | None:
+    """Newton simulator frames/s on the skirt (waist pinned) around a capsule body
+    (~5k triangles) that sways and bobs; ``None`` with a printed reason if it cannot run.
+    """
+    # ------------------------------------------------------------------------------
+    # SIMULATOR MEASUREMENT (model fps ÷ simulator fps is the ratio the docs report)
+    # ------------------------------------------------------------------------------
+    try:
+        import trimesh
+
+        from data_prep.simulate import SimulationFailed, SimulationSettings, simulate_garment
+    except ImportError as error:
+        print(f"simulator: not measured ({error})")
+        return None
+    try:
+        import warp
+
+        warp.config.quiet = True  # keep Warp's banner and per-module lines out of the report
+    except ImportError:
+        pass
+    fps = 30.0
+    body = trimesh.creation.capsule(height=0.9, radius=0.1, count=[50, 50])
+    rest = np.asarray(body.vertices) + np.array([0.0, 0.0, -0.25])   # z in [-0.8, 0.3]
+    t = np.arange(frames) / fps
+    offset = np.stack([0.04 * np.sin(2 * np.pi * t), np.zeros_like(t),
+                       0.01 * np.sin(4 * np.pi * t)], axis=1)         # (T, 3) metres
+    body_vertices = rest[None] + offset[:, None]
+    ring = np.flatnonzero(pos[:, 2] > -1e-9)
+    pin_targets = pos[ring][None] + offset[:, None]
+    settings = SimulationSettings(max_retries=0)
+    tic = time.perf_counter()
+    try:
+        result = simulate_garment(pos, faces, body_vertices, np.asarray(body.faces), fps,
+                                  "cotton", pinned=ring, pin_targets=pin_targets,
+                                  settings=settings)
+    except SimulationFailed as error:
+        print(f"simulator: not measured (failed its quality gates: {error})")
+        return None
+    print(f"simulator: {len(pos)} vertices, capsule of {len(body.faces)} triangles, "
+          f"{frames} frames + {settings.settle_frames} settle, {result.substeps} substeps × "
+          f"{settings.iterations} iterations, one core: {result.seconds_per_frame:.3f} "
+          f"s/frame = {1 / result.seconds_per_frame:.2f} frames/s (wall "
+          f"{time.perf_counter() - tic:.0f} s incl. setup)")
+    return 1 / result.seconds_per_frame
+
+
+def label(r: dict) -> str:
+    return f"{r['config']} | {r['attention']} | {r.get('malloc', 'default')} | {r['threads']}"
+
+
+def report(results: list[dict]) -> dict[str, float]:
+    """Print the tables; return each config's best float32 frames/s at the largest batch."""
+    best: dict[str, float] = {}
+    print("\n## frames/s (best of repeats; float32, inference_mode, both M^mp submodules)")
+    print("| config | attention | malloc | threads | batch | ms/batch | frames/s "
+          "| median frames/s | peak RSS MB |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for r in results:
+        largest = max(int(b) for b in r["batches"])
+        for frames, e in r["batches"].items():
+            fps = int(frames) / e["best_s"]
+            if int(frames) == largest:
+                best[r["config"]] = max(best.get(r["config"], 0.0), fps)
+            print(f"| {label(r)} | {frames} | {1000 * e['best_s']:.0f} | {fps:.1f} "
+                  f"| {int(frames) / e['median_s']:.1f} | {e['peak_rss_mb']:.0f} |")
+    for r in results:
+        for frames, e in r["batches"].items():
+            for key, diff in e.items():
+                if key.startswith("max_diff_vs_"):
+                    print(f"max |posed({r['attention']}) − posed({key[12:]})|, {label(r)}, "
+                          f"batch {frames}: {diff:.2e} m")
+
+    print("\n## where the time goes (best run, ms per batch)")
+    print("| config | attention | malloc | threads | batch | E^t1 LSTM | E^t2 LSTM "
+          "| M^mp sup. | M^mp phys. | skinning | rest | total |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in results:
+        for frames, e in r["batches"].items():
+            p = {k: 1000 * v for k, v in e["parts"].items()}
+            total = 1000 * e["best_s"]
+            print(f"| {label(r)} | {frames} "
+                  f"| {p.get('pose_encoder', 0):.0f} | {p.get('velocity_encoder', 0):.0f} "
+                  f"| {p.get('supervised_processor', 0):.0f} "
+                  f"| {p.get('physics_processor', 0):.0f} | {p.get('skinning', 0):.0f} "
+                  f"| {total - sum(p.values()):.0f} | {total:.0f} |")
+
+    if any("bf16" in e for r in results for e in r["batches"].values()):
+        print("\n## bf16 autocast vs float32")
+        print("posed-vertex error vs float32 (with random-init weights the blend shapes are "
+              "~1e-8 m: only the skinning-weight path shows); M^mp relative error on "
+              "unit-normal inputs. Weights: " + ", ".join(sorted(
+                  {f"{r['config']}: {r['weights']}" for r in results})))
+        print("| config | attention | malloc | threads | batch | bf16 where | frames/s "
+              "| speed-up | max err mm | mean err mm | M^mp rel. err |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|")
+        for r in results:
+            for frames, e in r["batches"].items():
+                for mode, where in (("bf16", "whole forward"),
+                                    ("bf16_processors", "M^mp only")):
+                    if mode not in e:
+                        continue
+                    m = e[mode]
+                    print(f"| {label(r)} | {frames} | {where} "
+                          f"| {int(frames) / m['best_s']:.1f} "
+                          f"| {e['best_s'] / m['best_s']:.2f}× | {m['max_mm']:.3f} "
+                          f"| {m['mean_mm']:.4f} | {m['processor_rel']:.1e} |")
+    for r in results:
+        print(f"\n{label(r)}: prepare (per pair, once) {r['prepare_s']:.2f} s; peak RSS "
+              f"after prepare {r['rss_after_prepare_mb']:.0f} MB")
+        if "profile" in r:
+            print(f"top operators, batch {max(int(b) for b in r['batches'])}:\n{r['profile']}")
+    return best
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--vertices", type=int, default=5000)
+    parser.add_argument("--configs", nargs="+", default=["small", "paper"])
+    parser.add_argument("--batches", type=int, nargs="+", default=[1, 16])
+    parser.add_argument("--attention", nargs="+", default=["csr", "pyg"],
+                        choices=["csr", "pyg"])
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--threads", type=int, nargs="+", default=[1, 2],
+                        help="intra-op threads (each value measured separately)")
+    parser.add_argument("--checkpoint", default=str(ROOT / "models" / "gnngarment-small.pt"),
+                        help="trained weights, used for the config whose network they fit "
+                             "('' for random init everywhere)")
+    parser.add_argument("--no-bf16", dest="bf16", action="store_false")
+    parser.add_argument("--no-simulator", dest="simulator", action="store_false")
+    parser.add_argument("--sim-frames", type=int, default=30)
+    parser.add_argument("--malloc", choices=["default", "tuned", "both"], default="both",
+                        help="glibc malloc settings of the csr runs (pyg: default)")
+    parser.add_argument("--profile-batch", type=int, default=16,
+                        help="print the top operators of the csr runs at this batch")
+    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("--config", help=argparse.SUPPRESS)
+    parser.add_argument("--impl", nargs="+", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        child(args)
+        return
+
+    print(f"torch {torch.__version__}, threads {args.threads}, {args.vertices}-vertex skirt, "
+          f"best of {args.repeats}; load average {os.getloadavg()[0]:.1f} on "
+          f"{os.cpu_count()} cores")
+    results = []
+    variants = ["default", "tuned"] if args.malloc == "both" else [args.malloc]
+    for threads, config, malloc in ((t, c, m) for t in args.threads for c in args.configs
+                                    for m in variants):
+        # All implementations in one child, interleaved; the tuned-malloc child only
+        # repeats the csr runs (the environment must be set when the process starts).
+        impls = args.attention if malloc == variants[0] else ["csr"]
+        command = [sys.executable, __file__, "--child", "--config", config,
+                   "--checkpoint", args.checkpoint,
+                   "--impl", *impls, "--vertices", str(args.vertices),
+                   "--repeats", str(args.repeats), "--threads", str(threads),
+                   "--profile-batch",
+                   str(args.profile_batch if malloc == variants[0] else -1),
+                   "--batches", *map(str, args.batches)]
+        if not args.bf16 or malloc != variants[0]:
+            command.append("--no-bf16")
+        env = dict(os.environ, **(MALLOC_TUNED if malloc == "tuned" else {}))
+        tic = time.perf_counter()
+        done = subprocess.run(command, capture_output=True, text=True, env=env, check=False)
+        lines = [ln for ln in done.stdout.splitlines() if ln.startswith("RESULT ")]
+        if done.returncode != 0 or not lines:
+            print(f"{config}/{malloc}/{threads} threads failed:\n{done.stderr[-3000:]}")
+            continue
+        for line in lines:
+            result = json.loads(line[len("RESULT "):])
+            result["malloc"] = malloc
+            results.append(result)
+        print(f"measured {config} ({', '.join(impls)}), malloc {malloc}, {threads} threads, "
+              f"in {time.perf_counter() - tic:.0f} s", flush=True)
+    best = report(results)
+
+    print()
+    simulator_fps = None
+    if args.simulator:
+        pos, faces = flared_skirt(args.vertices)
+        simulator_fps = measure_simulator(pos, faces, args.sim_frames)
+    else:
+        print("simulator: not measured (--no-simulator)")
+    for config, fps in best.items():
+        if simulator_fps:
+            print(f"model ÷ simulator, {config}: {fps:.1f} / {simulator_fps:.2f} frames/s = "
+                  f"{fps / simulator_fps:.0f}× (fastest float32 variant, batch "
+                  f"{max(args.batches)})")
+        else:
+            print(f"model ÷ simulator, {config}: simulator not measured")
+
+if __name__ == "__main__":
+    main()
