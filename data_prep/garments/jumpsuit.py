@@ -36,7 +36,7 @@ class JumpsuitStyle(Style):
     top_edge: float = number(0.04, 0.01, 0.1, "strapless: top edge below the armpits (m)")
     neckline: str = choice("round", NECKLINES, "neckline shape")
     neck_depth: float = number(0.07, 0.02, 0.16, "neckline depth in front (m)")
-    back_depth: float = number(0.02, 0.005, 0.06, "neckline depth at the back (m)")
+    back_depth: float = number(0.02, 0.015, 0.06, "neckline depth at the back (m)")
     neck_width: float = number(0.02, 0.0, 0.05, "neckline width beyond the neck, each side (m)")
 
 

@@ -5,10 +5,9 @@ closer to its arm's bone chain (shoulder → elbow → wrist → hand) than to t
 leg; a head vertex is a non-arm vertex above the neck joint; everything else is the
 *trunk* (torso and legs). Then, in 1 cm slabs:
 
-* the trunk's section (centre, half-width, front and back depth, and the smallest
-  superellipse exponent that contains every slab vertex) from the feet to the
-  shoulders: above the crotch it is the torso, below it both legs together (what a
-  skirt must clear);
+* the trunk's section (centre, half-width, front and back depth, and the superellipse
+  of least area that holds every slab vertex) from the feet to the shoulders: above
+  the crotch it is the torso, below it both legs together (what a skirt must clear);
 * each leg's section below the crotch (trousers);
 * each arm's radius along its bone chain (sleeves);
 * the shoulder line (the highest trunk point across X), the neck radius, the crotch

@@ -5,7 +5,8 @@
 2. :func:`relax` evens the mesh out on that surface: tangential umbrella smoothing,
    then a Newton step back onto the surface; opening vertices slide along their loop
    and are projected onto the curve where the surface meets their cut. Vertices drift
-   freely across the side folds, so the seams leave no trace in the geometry.
+   freely across the side folds, so the seams leave no trace in the geometry. Between
+   relaxations, :func:`~.flips.delaunay_flips` removes the slivers of the flat pattern.
 3. :func:`push_out` moves any vertex closer to the body than the clearance outward
    (along the direction from the closest body point), spread smoothly over neighbours.
 """
@@ -229,26 +230,38 @@ def _keep_inside(design: Design, points: np.ndarray, margin: float) -> np.ndarra
 
 def push_out(pos: np.ndarray, faces: np.ndarray, body: BodyDistance, clearance: float,
              rounds: int = 4) -> tuple[np.ndarray, float]:
-    """Move vertices closer than ``clearance`` (metres) to the body outward, smoothly.
+    """Move vertices closer than ``clearance`` (metres) to the body outward, smoothly;
+    likewise the corners of a face whose centre is closer than half of it (a bump of
+    the body between the vertices).
 
     Returns:
-        ``(N, 3)`` positions and the smallest signed body distance after the last round.
+        ``(N, 3)`` positions and the smallest signed body distance of a vertex after the
+        last round.
     """
     matrix = adjacency(faces, len(pos))
     degree = np.asarray(matrix.sum(axis=1)).ravel()
-    distance, _, direction = body.query(pos, exact_below=2 * clearance)
-    for _ in range(rounds):
-        short = distance < clearance
+    distance = np.zeros(len(pos))
+    for round_ in range(rounds + 1):
+        distance, _, direction = body.query(pos, exact_below=2 * clearance)
+        if round_ == rounds:
+            break
+        need = np.clip(clearance - distance, 0.0, None)
+        push = need[:, None] * direction
+        centre_distance, _, centre_direction = body.query(pos[faces].mean(axis=1),
+                                                          exact_below=clearance)
+        low = np.flatnonzero(centre_distance < 0.5 * clearance)
+        for corner in range(3):
+            np.add.at(push, faces[low, corner],
+                      (clearance - centre_distance[low])[:, None] * centre_direction[low] / 3)
+        short = np.linalg.norm(push, axis=1) > 0
         if not short.any():
             break
-        need = np.where(short, clearance - distance + 0.1 * clearance, 0.0)
-        fixed = need[:, None] * direction
+        fixed = push * 1.1
         shift = fixed
         # Spread the push over a few rings of neighbours so no single vertex spikes out.
         for _ in range(3):
             shift = np.where(short[:, None], fixed, matrix @ shift / degree[:, None])
         pos = pos + shift
-        distance, _, direction = body.query(pos, exact_below=2 * clearance)
     return pos, float(distance.min())
 
 
@@ -263,6 +276,7 @@ def mesh_design(design: Design, body: BodyDistance, target_vertices: int,
         target_vertices: approximate vertex count.
         rng: random generator (interior points of the pattern).
         clearance: minimum distance (metres) of every vertex from the body.
+        iterations: smoothing steps in all (split over three relaxations).
 
     Raises:
         PatternError: the design cannot be meshed cleanly (the sampler retries).

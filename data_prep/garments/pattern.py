@@ -4,14 +4,15 @@ Seen from the front, a garment around a body in T- or A-pose is a flat region Ω
 (shirt: a T; trousers: an upside-down U); the garment is a *front* and a *back* panel
 of that shape, sewn together along the seams (the silhouette) and left open along the
 cuts (hem, cuffs, neck, waist, armholes). We find Ω from the implicit design
-(:class:`~data_prep.garments.shapes.Design`) on a 1 cm grid: a point is in Ω when the
-line through it along Y enters the garment's solid and no cut removes it there. Each
-boundary stretch of Ω is a *seam* (shared by both panels) or an *opening* (one copy per
-panel). Both panels are triangulated by conforming Delaunay triangulations with the
-same boundary points but different random interior points, and stitched along the
-seams, so the result is a manifold by construction: every seam edge has one front and
-one back triangle, and each opening of Ω becomes one closed boundary loop (front half +
-back half).
+(:class:`~data_prep.garments.shapes.Design`) on a 1–2 cm grid: a point is in a panel's
+Ω when the line through it along Y enters the garment's solid and no cut removes the
+point where that panel's surface is (front and back differ only where a cut is
+tilted, e.g. a neckline deeper in front). Each boundary stretch of Ω is a *seam*
+(shared by both panels) or an *opening* (one copy per panel). Both panels are
+triangulated by conforming Delaunay triangulations with the same seam points but
+different random interior points, and stitched along the seams, so the result is a
+manifold by construction: every seam edge has one front and one back triangle, and
+each opening becomes one closed boundary loop (front half + back half).
 """
 
 from __future__ import annotations
@@ -457,7 +458,7 @@ def triangulate(pattern: Pattern, interior_count: dict[int, int],
     openings = {side: [run.copy() for run in runs] for side, runs in pattern.openings.items()}
     interiors: dict[int, np.ndarray] = {}
     forced: dict[int, np.ndarray] = {-1: np.zeros((0, 2)), 1: np.zeros((0, 2))}
-    for _attempt in range(10):
+    for _attempt in range(20):
         current = Pattern(seams=seams, openings=openings, order=pattern.order)
         panels, clean = {}, True
         seam_missing = [np.zeros(len(run) - 1, dtype=bool) for run in seams]

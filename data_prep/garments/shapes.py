@@ -5,9 +5,11 @@ A garment is the boundary of the union of a few smooth solids (a torso or skirt
 armholes). Every solid is a field ``f(x)`` that is negative inside and roughly a
 signed distance in metres near its surface; the union is a polynomial smooth minimum,
 so junctions (armpit, crotch) get a fillet of width ``blend`` instead of a crease. A
-cut ``c(x)`` keeps the part of the surface where ``c >= 0``. Cuts are extruded along Y
-(the body's front–back axis) up to an optional tilt, so a cut is the same curve on
-the front and the back panel of the sewing pattern (:mod:`.pattern`).
+cut ``c(x)`` keeps the part of the surface where ``c >= 0``. Cuts are planes, disks
+across a limb, or regions extruded along Y (the body's front–back axis) with an
+optional tilt, so that they cut both panels of the sewing pattern (:mod:`.pattern`)
+along one curve each. Solids give an analytic gradient (:meth:`Design.field_and_gradient`)
+for the mesher's Newton steps.
 """
 
 from __future__ import annotations
@@ -337,15 +339,18 @@ class VCut:
 
 @dataclasses.dataclass
 class UnionCut:
-    """Remove what any of ``parts`` removes (a V-neck: a V in front, round at the back)."""
+    """Remove what any of ``parts`` removes (a V-neck: a V in front, round at the back),
+    with the corners where their rims meet rounded over ``blend`` metres (a sharp
+    corner in an opening's loop makes slivers)."""
 
     name: str
     parts: tuple
+    blend: float = 0.015
 
     def __call__(self, points: np.ndarray) -> np.ndarray:
         value = self.parts[0](points)
         for part in self.parts[1:]:
-            value = np.minimum(value, part(points))
+            value = smooth_min(value, part(points), self.blend)
         return value
 
 

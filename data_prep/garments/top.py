@@ -27,7 +27,7 @@ class TopStyle(Style):
     armhole_drop: float = number(0.02, 0.0, 0.07, "armhole depth below the armpit (m)")
     neckline: str = choice("round", NECKLINES, "neckline shape")
     neck_depth: float = number(0.08, 0.03, 0.16, "neckline depth in front (m)")
-    back_depth: float = number(0.03, 0.005, 0.08, "neckline depth at the back (m)")
+    back_depth: float = number(0.03, 0.015, 0.08, "neckline depth at the back (m)")
     neck_width: float = number(0.02, 0.0, 0.05, "neckline width beyond the neck, each side (m)")
     top_edge: float = number(0.04, 0.01, 0.1, "strapless: top edge below the armpits (m)")
 

@@ -28,7 +28,7 @@ class TShirtStyle(Style):
     neckline: str = choice("round", NECKLINES, "neckline shape")
     neck_depth: float = number(0.05, 0.02, 0.14, "neckline depth in front, below the shoulder "
                                "line (m)")
-    back_depth: float = number(0.015, 0.005, 0.04, "neckline depth at the back (m)")
+    back_depth: float = number(0.02, 0.015, 0.04, "neckline depth at the back (m)")
     neck_width: float = number(0.015, 0.0, 0.05, "neckline width beyond the neck, each side (m)")
     front_rise: float = number(0.0, -0.03, 0.05, "hem higher in front than at the back (m)")
 
