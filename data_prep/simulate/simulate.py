@@ -99,7 +99,8 @@ def simulate_garment(garment_rest: np.ndarray, garment_faces: np.ndarray,
 
     Raises:
         ValueError: malformed input (the message names the argument) or unknown fabric.
-        SimulationFailed: every attempt (``1 + settings.max_retries``) failed a gate.
+        SimulationFailed: every attempt (at most ``1 + settings.max_retries``; fewer when
+            ``settings.retry_only_if_progress`` and a retry got no further) failed a gate.
         ImportError: Newton / Warp missing.
     """
     settings = settings if settings is not None else SimulationSettings()
@@ -114,6 +115,9 @@ def simulate_garment(garment_rest: np.ndarray, garment_faces: np.ndarray,
         if result is not None:
             result.attempts = attempt + 1
             return result
+        if (settings.retry_only_if_progress and attempt > 0
+                and report.frames_simulated <= reports[-2].frames_simulated):
+            break  # more substeps did not get further: a third try would not either
         substeps *= settings.retry_substep_factor
     raise SimulationFailed(reports)
 

@@ -139,7 +139,8 @@ def test_failing_sequence_is_retried_with_more_substeps_then_raises() -> None:
     body_rest, body_faces = _sphere(0.1, centre=(5.0, 0.0, 0.0), subdivisions=1)
     corner = np.array([0])  # pinned: the cloth swings and stretches a little
     settings = SimulationSettings(substeps=2, settle_frames=0, max_retries=2,
-                                  retry_substep_factor=2, max_edge_stretch=1.0001)
+                                  retry_substep_factor=2, max_edge_stretch=1.0001,
+                                  retry_only_if_progress=False)
     with pytest.raises(SimulationFailed, match="max edge stretch") as caught:
         simulate_garment(pos, faces, np.stack([body_rest] * 6), body_faces, FPS, "silk",
                          pinned=corner, settings=settings)
@@ -150,6 +151,19 @@ def test_failing_sequence_is_retried_with_more_substeps_then_raises() -> None:
         assert not report.ok
         # Each attempt stops at its first failing frame (frame 0 is the rest shape).
         assert report.frames_simulated == 2 and "frame 1" in report.failure
+
+
+def test_retries_stop_when_more_substeps_get_no_further() -> None:
+    pos, faces = _square(cells=4, size=0.2, height=0.5)
+    body_rest, body_faces = _sphere(0.1, centre=(5.0, 0.0, 0.0), subdivisions=1)
+    settings = SimulationSettings(substeps=2, settle_frames=0, max_retries=3,
+                                  retry_substep_factor=2, max_edge_stretch=1.0001)
+    assert settings.retry_only_if_progress  # the default
+    with pytest.raises(SimulationFailed) as caught:
+        simulate_garment(pos, faces, np.stack([body_rest] * 6), body_faces, FPS, "silk",
+                         pinned=np.array([0]), settings=settings)
+    # Both attempts fail at frame 1: the third and fourth would be wasted work.
+    assert [r.substeps for r in caught.value.reports] == [2, 4]
 
 
 def test_signed_distance_to_a_sphere() -> None:

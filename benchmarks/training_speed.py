@@ -1,0 +1,111 @@
+"""Training throughput: optimiser steps/s and frames/s of each training stage.
+
+Runs the trainer's own step (:class:`~gnngarment.training.trainer.TrainingStep`,
+:func:`~gnngarment.training.objective.stage_loss`, Adamax) on a prepared cache for a
+fixed number of batches per stage — supervised (all parameters, vertex + edge + normal
+losses), physics (second M^mp only; collision + gravity) and physics with strain
+(+ stretch + shear) — and prints seconds per step, frames/s and vertices/s. Batches are
+the trainer's (``pairs_per_batch`` garment–body pairs × ``frames_per_pair`` frames,
+mixed garments).
+
+    .venv/bin/python benchmarks/training_speed.py [--config configs/train/demo.yaml]
+        [--data data/demo] [--steps 10] [--threads 1]
+
+Without a prepared cache at ``--data`` it prints how to build one and exits 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from gnngarment.data import PreparedDataset  # noqa: E402
+from gnngarment.model import GarmentDeformer  # noqa: E402
+from gnngarment.training.loading import load_training_config  # noqa: E402
+from gnngarment.training.objective import stage_loss  # noqa: E402
+from gnngarment.training.trainer import TrainingStep, set_stage  # noqa: E402
+
+STAGES = ("supervised", "physics", "physics_strain")
+
+
+def measure(config_path: Path, data: Path, steps: int, threads: int) -> dict:
+    """Seconds per optimiser step for each stage (first step of each stage discarded as a
+    warm-up). Returns a JSON-able dict."""
+    config = load_training_config(config_path, [f"data={data}"])
+    torch.set_num_threads(threads)
+    torch.manual_seed(config.seed)
+    dataset = PreparedDataset(config.data, "train", config.model.window)
+    model = GarmentDeformer(config.model)
+    step = TrainingStep(model)
+    optimiser = torch.optim.Adamax(model.parameters(), lr=config.learning_rate)
+    rng = np.random.default_rng(config.seed)
+    groups = list(dataset.batches(config.pairs_per_batch, config.frames_per_pair, rng))
+    results = {"config": str(config_path), "data": str(data), "threads": threads,
+               "pairs_per_batch": config.pairs_per_batch,
+               "frames_per_pair": config.frames_per_pair, "stages": {}}
+    for stage in STAGES:
+        set_stage(model, stage)
+        times, frames, vertices = [], 0, 0
+        for index in range(steps + 1):
+            items = groups[index % len(groups)]
+            tic = time.perf_counter()
+            batch = dataset.batch(items)
+            output = step(batch)
+            total, _ = stage_loss(output, batch, stage, config.losses, config.stages,
+                                  config.collision_margin)
+            optimiser.zero_grad(set_to_none=True)
+            total.backward()
+            optimiser.step()
+            elapsed = time.perf_counter() - tic
+            if index == 0:
+                continue  # warm-up: cached graph structures, allocator
+            times.append(elapsed)
+            count = sum(len(chunk) for _, chunk in items)
+            frames += count
+            vertices += int(output.posed.shape[0])
+        seconds = float(np.sum(times))
+        results["stages"][stage] = {
+            "seconds_per_step": seconds / steps, "median_seconds_per_step": float(np.median(times)),
+            "frames_per_second": frames / seconds, "vertices_per_second": vertices / seconds}
+    return results
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--config", type=Path, default=ROOT / "configs/train/demo.yaml")
+    parser.add_argument("--data", type=Path, default=ROOT / "data/demo")
+    parser.add_argument("--steps", type=int, default=10)
+    parser.add_argument("--threads", type=int, default=1)
+    parser.add_argument("--json", type=Path, help="also write the results here")
+    args = parser.parse_args()
+    if not (args.data / "manifest.json").is_file():
+        print(f"{args.data}: no prepared cache (build it with `gnngarment prepare --config "
+              "configs/data/demo.yaml`, or `make demo`)", file=sys.stderr)
+        raise SystemExit(2)
+    print(f"torch {torch.__version__}, {args.threads} thread(s), load average "
+          f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    results = measure(args.config, args.data, args.steps, args.threads)
+    print(f"{results['pairs_per_batch']} pairs × {results['frames_per_pair']} frames per "
+          f"batch, {args.steps} steps per stage after one warm-up step, {args.data}")
+    print("| stage | s/step (mean) | s/step (median) | frames/s | vertices/s |")
+    print("|---|---|---|---|---|")
+    for stage, row in results["stages"].items():
+        print(f"| {stage} | {row['seconds_per_step']:.3f} | {row['median_seconds_per_step']:.3f}"
+              f" | {row['frames_per_second']:.1f} | {row['vertices_per_second']:.0f} |")
+    if args.json:
+        args.json.write_text(json.dumps(results, indent=2))
+
+
+if __name__ == "__main__":
+    main()
