@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from data_prep.config import DataConfig
-from gnngarment.geometry.files import atomic_write, atomic_write_bytes
+from gnngarment.geometry.files import TEMP_SUFFIX, atomic_write, atomic_write_bytes
 
 #: Bumped when the builder's output changes for the same config (forces a rebuild).
 BUILDER_VERSION = 1
@@ -270,8 +270,7 @@ def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[s
         features = motion_features(motion).numpy()
         off = left_the_body(result.positions, body_vertices[:, samples])
         if off:
-            return {"name": plan.name, "ok": False, "reason": off,
-                    "seconds": time.perf_counter() - started}
+            return _left_out(root, plan.name, inputs_hash, off, started)
         record = SequenceRecord(
             name=plan.name, garment=plan.garment, body=plan.body.name, motion=plan.motion.name,
             fps=config.fps, positions=result.positions, joint_transforms=transforms,
@@ -295,8 +294,7 @@ def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[s
                 "max_stretch": float(np.nanmax(result.quality.max_stretch)),
                 "max_inside_pct": 100 * float(np.nanmax(result.quality.inside_fraction))}
     except SimulationFailed as error:
-        return {"name": plan.name, "ok": False, "reason": str(error),
-                "seconds": time.perf_counter() - started}
+        return _left_out(root, plan.name, inputs_hash, str(error), started)
     except Exception as error:  # a broken garment or body: report, don't kill the build
         import traceback
 
@@ -304,6 +302,28 @@ def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[s
         return {"name": plan.name, "ok": False,
                 "reason": f"{type(error).__name__}: {error} ({Path(where.filename).name}:"
                           f"{where.lineno})", "seconds": time.perf_counter() - started}
+
+
+def _left_out(root: Path, name: str, inputs_hash: str, reason: str,
+              started: float) -> dict[str, Any]:
+    """Record a sequence that failed its quality gates (with its input hash, so that a
+    resumed build does not simulate it again) and return its status dict."""
+    folder = root / "sequences"
+    folder.mkdir(parents=True, exist_ok=True)
+    atomic_write_bytes(folder / f"{name}.failed",
+                       json.dumps({"inputs_hash": inputs_hash, "reason": reason}).encode())
+    return {"name": name, "ok": False, "reason": reason,
+            "seconds": time.perf_counter() - started}
+
+
+def _known_failure(root: Path, name: str, inputs_hash: str) -> str | None:
+    """The recorded reason a sequence with these inputs failed before, if any."""
+    path = root / "sequences" / f"{name}.failed"
+    try:
+        record = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    return record.get("reason") if record.get("inputs_hash") == inputs_hash else None
 
 
 def _sequence_done(root: Path, name: str, inputs_hash: str) -> bool:
@@ -327,10 +347,17 @@ def build_dataset(config: DataConfig, workers: int | None = None,
     root = Path(config.output)
     root.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
+    # A killed build can leave the temporary file of a write it did not finish; no
+    # reader looks at those names, and this build will write the file again.
+    for stale in root.rglob(f".*{TEMP_SUFFIX}"):
+        stale.unlink(missing_ok=True)
     plans = plan_dataset(config)
     settings = load_simulation_settings(config.simulation)
-    base_hash = {"builder": BUILDER_VERSION, "config": asdict(config),
-                 "simulation": asdict(settings)}
+    # What decides a sequence's content: not where the dataset lives, how many
+    # processes build it, or the path of the simulation file (its settings are hashed).
+    content = {k: v for k, v in asdict(config).items()
+               if k not in ("output", "workers", "simulation")}
+    base_hash = {"builder": BUILDER_VERSION, "config": content, "simulation": asdict(settings)}
 
     bodies = {p.body.name: p.body for p in plans}
     for plan in tqdm(bodies.values(), desc="bodies", unit="body"):
@@ -347,6 +374,7 @@ def build_dataset(config: DataConfig, workers: int | None = None,
             log(f"garment {name} left out: {failed_garments[name]}")
 
     tasks, skipped = [], 0
+    known_failures: dict[str, str] = {}
     for plan in plans:
         if plan.garment in failed_garments:
             continue
@@ -354,10 +382,15 @@ def build_dataset(config: DataConfig, workers: int | None = None,
         if _sequence_done(root, plan.name, inputs_hash):
             skipped += 1
             continue
+        reason = _known_failure(root, plan.name, inputs_hash)
+        if reason is not None:  # same inputs failed before: it would fail again
+            known_failures[plan.name] = reason
+            continue
         tasks.append((str(root), plan, config, inputs_hash))
     workers = workers or config.workers or os.cpu_count() or 1
-    log(f"{len(plans)} sequences planned: {skipped} already built, {len(tasks)} to simulate "
-        f"with {min(workers, max(len(tasks), 1))} worker(s)")
+    log(f"{len(plans)} sequences planned: {skipped} already built, {len(known_failures)} "
+        f"failed before with the same inputs, {len(tasks)} to simulate with "
+        f"{min(workers, max(len(tasks), 1))} worker(s)")
     results = []
     if tasks:
         _warm_up_kernels(log)
@@ -370,7 +403,7 @@ def build_dataset(config: DataConfig, workers: int | None = None,
                 if not result["ok"]:
                     log(f"sequence {result['name']} left out: {result['reason']}")
 
-    failed = {r["name"]: r["reason"] for r in results if not r["ok"]}
+    failed = known_failures | {r["name"]: r["reason"] for r in results if not r["ok"]}
     built = [p for p in plans if p.garment not in failed_garments and p.name not in failed
              and (root / "sequences" / f"{p.name}.npz").is_file()]
     splits = {split: [p.name for p in built if p.split == split]

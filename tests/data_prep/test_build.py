@@ -1,0 +1,102 @@
+"""Dataset build: the plan holds out garments, bodies and motions; a build killed with
+SIGKILL resumes without re-simulating finished sequences and never reads a partial file;
+sequences that failed their gates are not simulated again with the same inputs."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import asdict, replace
+from pathlib import Path
+
+import pytest
+from omegaconf import OmegaConf
+
+from data_prep.build import _known_failure, _left_out, build_dataset, plan_dataset
+from data_prep.config import DataConfig
+from gnngarment.config import load_config
+from gnngarment.data import PreparedDataset
+from gnngarment.geometry.files import TEMP_SUFFIX
+from gnngarment.paths import REPOSITORY_ROOT
+
+TINY = REPOSITORY_ROOT / "configs" / "data" / "tiny.yaml"
+
+
+def tiny_config(output: Path) -> DataConfig:
+    config = load_config(TINY, DataConfig)
+    config.output = str(output)
+    config.simulation = str(REPOSITORY_ROOT / config.simulation)
+    return config
+
+
+def test_plan_holds_out_garments_bodies_and_motions(tmp_path: Path) -> None:
+    config = load_config(REPOSITORY_ROOT / "configs" / "data" / "demo.yaml", DataConfig)
+    plans = plan_dataset(config)
+    assert plans == plan_dataset(config)  # deterministic
+    train = [p for p in plans if p.split == "train"]
+    for split in ("val", "test"):
+        held = [p for p in plans if p.split == split]
+        assert held, split
+        for attribute in ("design", "body", "motion"):
+            seen = {getattr(p, attribute).name for p in train}
+            assert not {getattr(p, attribute).name for p in held} & seen, (split, attribute)
+
+
+def test_recorded_failure_is_tied_to_its_inputs(tmp_path: Path) -> None:
+    _left_out(tmp_path, "skirt000_body00_walk00", "hash-a", "max edge stretch", time.perf_counter())
+    assert _known_failure(tmp_path, "skirt000_body00_walk00", "hash-a") == "max edge stretch"
+    assert _known_failure(tmp_path, "skirt000_body00_walk00", "hash-b") is None  # inputs changed
+    assert _known_failure(tmp_path, "other", "hash-a") is None
+    (tmp_path / "sequences" / "truncated.failed").write_text('{"inputs_ha')
+    assert _known_failure(tmp_path, "truncated", "hash-a") is None
+
+
+@pytest.mark.slow
+def test_build_killed_mid_way_resumes(tmp_path: Path) -> None:
+    """Start `gnngarment prepare` with one worker, SIGKILL its whole process group as
+    soon as the first sequence is written, rebuild: finished sequences are skipped, the
+    rest are simulated, and every sequence in the manifest reads back complete."""
+    config = tiny_config(tmp_path / "data")
+    config_file = tmp_path / "tiny.yaml"
+    config_file.write_text(OmegaConf.to_yaml(OmegaConf.create(asdict(config))))
+    process = subprocess.Popen(
+        [sys.executable, "-m", "gnngarment.cli", "prepare", "--config", str(config_file),
+         "--workers", "1"], cwd=REPOSITORY_ROOT, stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL, start_new_session=True)
+    sequences = tmp_path / "data" / "sequences"
+    deadline = time.monotonic() + 600
+    try:
+        while not list(sequences.glob("*.hash")):
+            assert process.poll() is None, "the build ended before it could be killed"
+            assert time.monotonic() < deadline, "no sequence written in 10 minutes"
+            time.sleep(0.05)
+    finally:
+        os.killpg(process.pid, signal.SIGKILL)  # the builder and its simulation worker
+        process.wait()
+    finished = {p.stem for p in sequences.glob("*.hash")}
+    assert not (tmp_path / "data" / "manifest.json").exists()
+    planned = {p.name for p in plan_dataset(config)}
+    assert finished < planned  # killed part-way
+
+    report = build_dataset(replace(config, workers=1), log=lambda _: None)
+    assert report["skipped_existing"] >= len(finished)
+    assert report["simulated"] + report["skipped_existing"] == len(planned)
+    manifest = json.loads((tmp_path / "data" / "manifest.json").read_text())
+    built = set(manifest["sequences"])
+    assert finished <= built
+    assert built | set(report["failed_sequences"]) == planned
+    for split in ("train", "val", "test"):
+        dataset = PreparedDataset(tmp_path / "data", split, window=3)
+        for name in dataset.sequence_names:
+            batch = dataset.batch([(name, [0, dataset.frame_counts[name] - 1])])
+            assert batch.target.isfinite().all()
+    # The killed build's temporary files (if it died mid-write) were cleaned up.
+    assert not [p for p in (tmp_path / "data").rglob(f"*{TEMP_SUFFIX}")]
+
+    again = build_dataset(replace(config, workers=1), log=lambda _: None)
+    assert again["simulated"] == 0  # built and failed sequences are both remembered
+    assert again["manifest_hash"] == report["manifest_hash"]
