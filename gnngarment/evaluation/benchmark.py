@@ -10,6 +10,7 @@ from typing import Any
 
 from gnngarment.data.dataset import PreparedDataset
 from gnngarment.evaluation.evaluate import METRICS, evaluate
+from gnngarment.geometry.files import atomic_write_bytes
 from gnngarment.training.checkpoint import load_model
 from gnngarment.training.config import TrainingConfig
 from gnngarment.training.trainer import CHECKPOINT_NAME, SUPERVISED_CHECKPOINT_NAME, Trainer
@@ -32,6 +33,8 @@ def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | No
     rows: dict[str, dict[str, float]] = {}
     seconds: dict[str, float] = {}
     lbs: dict[str, float] | None = None
+    by_type: dict[str, dict[str, dict[str, float]]] = {}
+    by_type_lbs: dict[str, dict[str, float]] = {}
     for name in names:
         levels, pooling = VARIANTS[name]
         variant = replace(config, output=str(Path(config.output) / name.replace(" ", "_")
@@ -51,10 +54,13 @@ def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | No
                 continue
             report = evaluate({name: load_model(path)}, test, body_skinning=lbs is None)
             rows[f"{name}, {label}"] = report.results[name]["all"]
+            by_type[f"{name}, {label}"] = report.results[name]
             if lbs is None and "body skinning (LBS)" in report.results:
                 lbs = report.results["body skinning (LBS)"]["all"]
+                by_type_lbs = report.results["body skinning (LBS)"]
     if lbs is not None:
         rows = {"body skinning (LBS)": lbs, **rows}
+        by_type = {"body skinning (LBS)": by_type_lbs, **by_type}
     lines = ["# Accuracy on held-out garments, bodies and motions", "",
              f"Split `{split}` of `{config.data}`; every learned variant trained with the same "
              f"config ({config.epochs} epochs max, same stage rules, seed {config.seed}).", "",
@@ -63,8 +69,15 @@ def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | No
     for name, values in rows.items():
         lines.append(f"| {name} | " + " | ".join(f"{values.get(m, float('nan')):.4g}"
                                                   for m in METRICS) + " |")
+    types = sorted({t for results in by_type.values() for t in results if t != "all"})
+    if types:
+        lines += ["", "E_verts (mm) by garment type:", "",
+                  "| method | " + " | ".join(types) + " |", "|" + "---|" * (len(types) + 1)]
+        for name, results in by_type.items():
+            lines.append(f"| {name} | " + " | ".join(
+                f"{results.get(t, {}).get('e_verts_mm', float('nan')):.4g}" for t in types)
+                + " |")
     lines += ["", "Training time per variant (s): " + ", ".join(
         f"{k} {v:.0f}" for k, v in seconds.items())]
-    output.parent.mkdir(parents=True, exist_ok=True)
-    output.write_text("\n".join(lines) + "\n")
+    atomic_write_bytes(output, ("\n".join(lines) + "\n").encode())
     return {"rows": rows, "seconds": seconds}
