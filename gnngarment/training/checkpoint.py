@@ -61,6 +61,24 @@ def load_model(path: str | Path) -> GarmentDeformer:
     return model
 
 
+#: What a released (shipped) checkpoint keeps: enough to rebuild the model and to say how
+#: it was made; the optimiser, scheduler and RNG states only matter for resuming.
+RELEASE_KEYS = ("model_config", "model_state", "use_physics", "epoch", "schedule",
+                "training_config", "data_manifest_hash", "history")
+
+
+def release_checkpoint(source: str | Path, destination: str | Path) -> Path:
+    """Write ``source`` without its training-only state (optimiser, scheduler, RNG) to
+    ``destination`` (atomically): a training run's ``last.pt`` → a model to ship.
+
+    Raises:
+        ValueError: ``source`` is not a readable checkpoint (names it).
+    """
+    payload = load_checkpoint(source)
+    save_checkpoint(destination, {k: payload[k] for k in RELEASE_KEYS if k in payload})
+    return Path(destination)
+
+
 def rng_state() -> dict[str, Any]:
     """torch, numpy-global and python RNG states as plain tensors/lists (safe to load
     with ``weights_only``)."""

@@ -9,9 +9,9 @@ import pytest
 import torch
 
 from gnngarment.data import PreparedDataset
-from gnngarment.training.checkpoint import load_checkpoint, load_model
+from gnngarment.training.checkpoint import load_checkpoint, load_model, release_checkpoint
 from gnngarment.training.config import StageConfig, TrainingConfig
-from gnngarment.training.trainer import Trainer
+from gnngarment.training.trainer import Trainer, TrainingStep
 from tests.model.pairs import tiny_config
 from tests.synthetic_cache import build_synthetic_cache
 
@@ -87,3 +87,22 @@ def test_checkpoints_are_safe_and_bad_ones_are_named(cache: Path, tmp_path: Path
     with pytest.raises(ValueError, match="absent.pt: checkpoint not found"):
         load_checkpoint(tmp_path / "absent.pt")
     assert [p.name for p in path.parent.iterdir() if p.suffix == ".tmp"] == []
+
+
+def test_released_checkpoint_drops_training_state_and_predicts_the_same(
+        cache: Path, tmp_path: Path) -> None:
+    config = config_for(cache, tmp_path / "run", epochs=1)
+    trainer = make_trainer(config, validation=False)
+    trainer.fit()
+    released = release_checkpoint(tmp_path / "run" / "last.pt", tmp_path / "model.pt")
+    payload = load_checkpoint(released)
+    assert not {"optimiser", "scheduler", "rng"} & set(payload)
+    assert payload["data_manifest_hash"] == trainer.train_data.manifest["hash"]
+    assert released.stat().st_size < (tmp_path / "run" / "last.pt").stat().st_size
+    dataset = PreparedDataset(config.data, "train", config.model.window)
+    name = dataset.sequence_names[0]
+    batch = dataset.batch([(name, [0, 1])])
+    with torch.no_grad():
+        a = TrainingStep(load_model(tmp_path / "run" / "last.pt"))(batch).posed
+        b = TrainingStep(load_model(released))(batch).posed
+    assert torch.equal(a, b)
