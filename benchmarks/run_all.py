@@ -138,9 +138,10 @@ def main() -> None:
              str(folder / "animated")], log)
         failures += ["animate"] if code else []
         if code == 0:
-            files = sorted(p.name for p in (folder / "animated").rglob("*") if p.is_file())
-            log.append(f"60 frames in {seconds:.1f} s including Python start-up, model and "
-                       f"Anny loading, context preparation and every export "
+            files = [p for p in (folder / "animated").rglob("*") if p.is_file()]
+            frames = len(list((folder / "animated").rglob("garment_*.obj")))
+            log.append(f"{frames} frames in {seconds:.1f} s including Python start-up, model "
+                       f"and Anny loading, context preparation and every export "
                        f"({len(files)} files).\n")
 
     total = time.perf_counter() - started
