@@ -137,8 +137,10 @@ def run(out: Path, data_config: Path, train_config: Path, model_path: Path | Non
 
     started = time.perf_counter()
     console.rule("5/5 attribution heatmap (integrated gradients, Gauss-Legendre)")
+    # Log colour scale: a trained model's attribution decays over decades from its target.
     attribution = run_attribution(animator, pos, faces, body, frames, out / "attribution",
-                                  n_steps=attribution_steps, source=str(garment_path))
+                                  n_steps=attribution_steps, source=str(garment_path),
+                                  scale="log")
     seconds["attribution"] = time.perf_counter() - started
     summary["attribution"] = {k: v for k, v in attribution.items()
                               if isinstance(v, (int, float, str))}
