@@ -15,5 +15,5 @@ def default_config(name: str) -> Path:
     return CONFIG_DIRECTORY / name
 
 #: The pretrained checkpoint kept in the repository (trained by
-#: ``gnngarment train --config configs/train/shipped.yaml``; see models/README.md).
+#: ``gnngarment train --config configs/train/benchmark.yaml``; see models/README.md).
 SHIPPED_MODEL = REPOSITORY_ROOT / "models" / "gnngarment-small.pt"
