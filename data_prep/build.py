@@ -54,15 +54,18 @@ def left_the_body(positions: np.ndarray, body_points: np.ndarray,
 
     # The body points under the garment at rest: how far *they* move up or down is the
     # body's own motion (a squat lowers the torso, not the feet).
-    under = cKDTree(body_points[0]).query(rest)[1] if rest is not None else None
+    if rest is not None:
+        under = cKDTree(body_points[0]).query(rest)[1]
+        under_height = body_points[:, under, 2].mean(axis=1)   # (T,)
+        rest_height = float(rest[:, 2].mean())
     for t in range(len(positions)):
         distance = float(cKDTree(body_points[t]).query(positions[t])[0].mean())
         if distance > limit:
             return (f"garment slid off the body: mean distance {distance:.2f} m > {limit} m "
                     f"at frame {t}")
         if rest is not None:
-            body_rise = float(body_points[t, under, 2].mean() - body_points[0, under, 2].mean())
-            drop = float(rest[:, 2].mean() - positions[t, :, 2].mean()) + body_rise
+            body_rise = float(under_height[t] - under_height[0])
+            drop = rest_height - float(positions[t, :, 2].mean()) + body_rise
             if drop > max_drop:
                 return (f"garment fell down the body: mean drop {drop:.2f} m > {max_drop} m "
                         f"at frame {t}")

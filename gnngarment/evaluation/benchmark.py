@@ -30,11 +30,10 @@ def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | No
     """Train every variant with ``config`` (levels/pooling changed only), evaluate each
     before and after the physics stage, and write ``output`` (Markdown)."""
     names = variants or list(VARIANTS)
-    rows: dict[str, dict[str, float]] = {}
+    # method → {garment type or "all" → metrics}, body skinning first once evaluated.
+    results: dict[str, dict[str, dict[str, float]]] = {}
     seconds: dict[str, float] = {}
-    lbs: dict[str, float] | None = None
-    by_type: dict[str, dict[str, dict[str, float]]] = {}
-    by_type_lbs: dict[str, dict[str, float]] = {}
+    lbs: dict[str, dict[str, float]] | None = None
     for name in names:
         levels, pooling = VARIANTS[name]
         variant = replace(config, output=str(Path(config.output) / name.replace(" ", "_")
@@ -53,14 +52,12 @@ def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | No
             if not path.is_file():
                 continue
             report = evaluate({name: load_model(path)}, test, body_skinning=lbs is None)
-            rows[f"{name}, {label}"] = report.results[name]["all"]
-            by_type[f"{name}, {label}"] = report.results[name]
+            results[f"{name}, {label}"] = report.results[name]
             if lbs is None and "body skinning (LBS)" in report.results:
-                lbs = report.results["body skinning (LBS)"]["all"]
-                by_type_lbs = report.results["body skinning (LBS)"]
+                lbs = report.results["body skinning (LBS)"]
     if lbs is not None:
-        rows = {"body skinning (LBS)": lbs, **rows}
-        by_type = {"body skinning (LBS)": by_type_lbs, **by_type}
+        results = {"body skinning (LBS)": lbs, **results}
+    rows = {name: values["all"] for name, values in results.items()}
     lines = ["# Accuracy on held-out garments, bodies and motions", "",
              f"Split `{split}` of `{config.data}`; every learned variant trained with the same "
              f"config ({config.epochs} epochs max, same stage rules, seed {config.seed}).", "",
@@ -69,13 +66,13 @@ def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | No
     for name, values in rows.items():
         lines.append(f"| {name} | " + " | ".join(f"{values.get(m, float('nan')):.4g}"
                                                   for m in METRICS) + " |")
-    types = sorted({t for results in by_type.values() for t in results if t != "all"})
+    types = sorted({t for per_type in results.values() for t in per_type if t != "all"})
     if types:
         lines += ["", "E_verts (mm) by garment type:", "",
                   "| method | " + " | ".join(types) + " |", "|" + "---|" * (len(types) + 1)]
-        for name, results in by_type.items():
+        for name, per_type in results.items():
             lines.append(f"| {name} | " + " | ".join(
-                f"{results.get(t, {}).get('e_verts_mm', float('nan')):.4g}" for t in types)
+                f"{per_type.get(t, {}).get('e_verts_mm', float('nan')):.4g}" for t in types)
                 + " |")
     lines += ["", "Training time per variant (s): " + ", ".join(
         f"{k} {v:.0f}" for k, v in seconds.items())]
