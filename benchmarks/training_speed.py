@@ -1,7 +1,7 @@
 """Training throughput: optimiser steps/s and frames/s of each training stage.
 
-Runs the trainer's own step (:class:`~gnngarment.training.trainer.TrainingStep`,
-:func:`~gnngarment.training.objective.stage_loss`, Adamax) on a prepared cache for a
+Runs the trainer's own step (:meth:`~gnngarment.training.trainer.Trainer.step`: forward,
+the stage's loss, Adamax) on a prepared cache for a
 fixed number of batches per stage — supervised (all parameters, vertex + edge + normal
 losses), physics (second M^mp only; collision + gravity) and physics with strain
 (+ stretch + shear) — and prints seconds per step, frames/s and vertices/s. Batches are
@@ -31,49 +31,39 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from gnngarment.data import PreparedDataset  # noqa: E402
-from gnngarment.model import GarmentDeformer  # noqa: E402
 from gnngarment.training.loading import load_training_config  # noqa: E402
-from gnngarment.training.objective import stage_loss  # noqa: E402
-from gnngarment.training.trainer import TrainingStep, set_stage  # noqa: E402
+from gnngarment.training.trainer import Trainer, set_stage  # noqa: E402
 
 STAGES = ("supervised", "physics", "physics_strain")
 
 
 def measure(config_path: Path, data: Path, steps: int, threads: int) -> dict:
-    """Seconds per optimiser step for each stage (first step of each stage discarded as a
-    warm-up). Returns a JSON-able dict."""
-    config = load_training_config(config_path, [f"data={data}"])
-    torch.set_num_threads(threads)
-    torch.manual_seed(config.seed)
+    """Seconds per optimiser step (:meth:`Trainer.step`) for each stage, the first step of
+    each stage discarded as a warm-up. Returns a JSON-able dict."""
+    config = load_training_config(config_path, [f"data={data}", f"threads={threads}"])
     dataset = PreparedDataset(config.data, "train", config.model.window)
-    model = GarmentDeformer(config.model)
-    step = TrainingStep(model)
-    optimiser = torch.optim.Adamax(model.parameters(), lr=config.learning_rate)
+    trainer = Trainer(config, dataset, None, progress=False)
+    trainer.step_module.train()
     rng = np.random.default_rng(config.seed)
     groups = list(dataset.batches(config.pairs_per_batch, config.frames_per_pair, rng))
     results = {"config": str(config_path), "data": str(data), "threads": threads,
                "pairs_per_batch": config.pairs_per_batch,
                "frames_per_pair": config.frames_per_pair, "stages": {}}
     for stage in STAGES:
-        set_stage(model, stage)
+        trainer.schedule.stage = stage
+        set_stage(trainer.model, stage)
         times, frames, vertices = [], 0, 0
         for index in range(steps + 1):
             items = groups[index % len(groups)]
             tic = time.perf_counter()
-            batch = dataset.batch(items)
-            output = step(batch)
-            total, _ = stage_loss(output, batch, stage, config.losses, config.stages,
-                                  config.collision_margin)
-            optimiser.zero_grad(set_to_none=True)
-            total.backward()
-            optimiser.step()
+            trainer.step(items)
             elapsed = time.perf_counter() - tic
             if index == 0:
                 continue  # warm-up: cached graph structures, allocator
             times.append(elapsed)
-            count = sum(len(chunk) for _, chunk in items)
-            frames += count
-            vertices += int(output.posed.shape[0])
+            for name, chunk in items:
+                frames += len(chunk)
+                vertices += len(chunk) * len(dataset.garment_of(name).pair.rest_pos)
         seconds = float(np.sum(times))
         results["stages"][stage] = {
             "seconds_per_step": seconds / steps, "median_seconds_per_step": float(np.median(times)),

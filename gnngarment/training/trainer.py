@@ -191,18 +191,7 @@ class Trainer:
         bar = tqdm(groups, desc=f"epoch {self.epoch + 1} [{self.schedule.stage}]",
                    disable=not self.progress, leave=False, unit="batch")
         for items in bar:
-            batch = self.train_data.batch(items)
-            output = self.step_module(batch)
-            total, terms = stage_loss(output, batch, self.schedule.stage, config.losses,
-                                      config.stages, config.collision_margin)
-            value = total.item()
-            if not math.isfinite(value):
-                raise FloatingPointError(f"loss became {value} at epoch {self.epoch + 1}"
-                                         f" (terms {terms}); lower the learning rate")
-            self.optimiser.zero_grad(set_to_none=True)
-            total.backward()
-            self.optimiser.step()
-            self.global_step += 1
+            value, terms = self.step(items)
             count += 1
             for name, term in terms.items():
                 sums[name] = sums.get(name, 0.0) + term
@@ -212,6 +201,28 @@ class Trainer:
         metrics["vertex_error_mm"] = 1000 * math.sqrt(metrics.get("vertex", 0.0))
         metrics["seconds"] = time.perf_counter() - started
         return metrics
+
+    def step(self, items: list[tuple[str, np.ndarray]]) -> tuple[float, dict[str, float]]:
+        """One optimiser step of the current stage on ``items`` (sequence name, frame
+        indices). Returns the total loss and its terms.
+
+        Raises:
+            FloatingPointError: the loss is not finite.
+        """
+        config = self.config
+        batch = self.train_data.batch(items)
+        output = self.step_module(batch)
+        total, terms = stage_loss(output, batch, self.schedule.stage, config.losses,
+                                  config.stages, config.collision_margin)
+        value = total.item()
+        if not math.isfinite(value):
+            raise FloatingPointError(f"loss became {value} at epoch {self.epoch + 1}"
+                                     f" (terms {terms}); lower the learning rate")
+        self.optimiser.zero_grad(set_to_none=True)
+        total.backward()
+        self.optimiser.step()
+        self.global_step += 1
+        return value, terms
 
     @torch.no_grad()
     def validate(self) -> dict[str, float]:
