@@ -43,10 +43,10 @@ PYTHON = sys.executable
 def run_step(title: str, command: list[str], log: list[str]) -> tuple[int, float]:
     """Run ``command`` from the repository root, echo its output, append a section to
     ``log``; returns (exit code, wall seconds)."""
-    shown = " ".join(shlex.quote(part if not part.startswith(str(ROOT) + "/")
-                                 else os.path.relpath(part, ROOT)) for part in command)
-    shown = shown.replace(shlex.quote(PYTHON), ".venv/bin/python").replace(PYTHON,
-                                                                          ".venv/bin/python")
+    shown = " ".join(shlex.quote(".venv/bin/python" if part == PYTHON
+                                 else os.path.relpath(part, ROOT)
+                                 if part.startswith(str(ROOT) + "/") else part)
+                     for part in command)
     print(f"\n=== {title}\n$ {shown}", flush=True)
     load = os.getloadavg()[0]
     tic = time.perf_counter()
