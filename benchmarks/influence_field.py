@@ -50,6 +50,7 @@ from gnngarment.attribution import (
 )
 from gnngarment.config import load_config
 from gnngarment.data.pair import GarmentBodyPair
+from gnngarment.evaluation.baselines import transfer_body_weights
 from gnngarment.geometry.hierarchy import PoolHierarchy, PoolLevel
 from gnngarment.geometry.prepare import GarmentPreparationConfig, prepare_garment
 from gnngarment.model.config import ModelConfig
@@ -75,6 +76,19 @@ class Body:
     joints: np.ndarray        # (24, 3)
     distances: np.ndarray     # (N_b', 24)
     frame: FrameInputs
+    rest_vertices: np.ndarray | None = None     # (N_b, 3), a real body only
+    skinning_weights: np.ndarray | None = None  # (N_b, 24), a real body only
+
+    def garment_weights(self, pos: np.ndarray) -> np.ndarray:
+        """``(N, 24)`` body skinning weights of the garment (the ``body`` weight prior):
+        transferred from a real body; on the synthetic skeleton, a soft nearest-joint
+        assignment (5 cm temperature)."""
+        if self.rest_vertices is not None and self.skinning_weights is not None:
+            return transfer_body_weights(pos, self.rest_vertices, self.skinning_weights)
+        distance = np.linalg.norm(pos[:, None] - self.joints[None], axis=-1)
+        logits = -(distance - distance.min(axis=1, keepdims=True)) / 0.05
+        weights = np.exp(logits)
+        return (weights / weights.sum(axis=1, keepdims=True)).astype(np.float32)
 
 
 def garments(skirt_vertices: int, tube_shape: tuple[int, int], waist: np.ndarray
@@ -149,7 +163,8 @@ def anny_body(config: ModelConfig, frame_index: int) -> Body:
     motion = load_motion("walk", fps=30.0, duration=2.0)
     frames = body_motion_inputs(body_model, shape, motion, config.body_vertices)
     return Body(joints=rest.joints, distances=rest.distances,
-                frame=FrameInputs.from_motion(frames, frame_index, config.window))
+                frame=FrameInputs.from_motion(frames, frame_index, config.window),
+                rest_vertices=rest.rest_vertices, skinning_weights=rest.skinning_weights)
 
 
 def make_pair(pos: np.ndarray, faces: np.ndarray, body: Body, config: ModelConfig,
@@ -163,7 +178,8 @@ def make_pair(pos: np.ndarray, faces: np.ndarray, body: Body, config: ModelConfi
         features=torch.from_numpy(garment_vertex_features(pos, faces, body.joints)),
         hierarchy=prepared.hierarchy,
         descriptor=torch.tensor(prepared.descriptor, dtype=torch.float32),
-        body_distances=torch.from_numpy(np.asarray(body.distances, dtype=np.float32)))
+        body_distances=torch.from_numpy(np.asarray(body.distances, dtype=np.float32)),
+        body_weights=torch.from_numpy(body.garment_weights(pos)))
 
 
 def build_models(arguments: argparse.Namespace) -> dict[str, GarmentDeformer]:

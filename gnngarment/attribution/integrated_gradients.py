@@ -197,4 +197,5 @@ def _pair_copy(pair: GarmentBodyPair, device: torch.device) -> GarmentBodyPair:
         return tensor.detach().to(device=device, dtype=torch.float32).clone()
 
     return replace(pair, rest_pos=copy(pair.rest_pos), features=copy(pair.features),
-                   descriptor=copy(pair.descriptor), body_distances=copy(pair.body_distances))
+                   descriptor=copy(pair.descriptor), body_distances=copy(pair.body_distances),
+                   body_weights=None if pair.body_weights is None else copy(pair.body_weights))

@@ -23,6 +23,8 @@ class BodyShapeInputs:
         distances: ``(N_b', 24)`` the body-shape feature ``D``.
         subset: ``(N_b',)`` indices of the feature vertices in the body template.
         rest_vertices: ``(N_b, 3)``; faces ``(F_b, 3)``.
+        skinning_weights: ``(N_b, 24)`` the body's own skinning weights per canonical
+            joint (rows sum to 1), or ``None`` when the body model does not expose them.
     """
 
     joints: np.ndarray
@@ -30,6 +32,7 @@ class BodyShapeInputs:
     subset: np.ndarray
     rest_vertices: np.ndarray
     faces: np.ndarray
+    skinning_weights: np.ndarray | None = None
 
 
 @dataclass
@@ -52,15 +55,22 @@ class BodyMotionInputs:
 
 
 def body_shape_inputs(body_model: BodyModel, shape: Any, count: int) -> BodyShapeInputs:
-    """Rest joints, feature ``D`` and the feature-vertex subset of ``count`` vertices."""
+    """Rest joints, feature ``D``, the feature-vertex subset of ``count`` vertices, the
+    rest mesh and (where the body model has them) its skinning weights."""
     rest = body_model.rest(shape)
     subset = body_model.feature_vertex_indices(count)
     distances = body_model.shape_features(shape, count)
+    try:
+        skinning_weights: np.ndarray | None = np.asarray(body_model.skinning_weights(),
+                                                         dtype=np.float32)
+    except NotImplementedError:
+        skinning_weights = None
     return BodyShapeInputs(joints=rest.joints.detach().cpu().numpy().astype(np.float32),
                            distances=distances.detach().cpu().numpy().astype(np.float32),
                            subset=np.asarray(subset, dtype=np.int64),
                            rest_vertices=rest.vertices.detach().cpu().numpy(),
-                           faces=np.asarray(rest.faces, dtype=np.int64))
+                           faces=np.asarray(rest.faces, dtype=np.int64),
+                           skinning_weights=skinning_weights)
 
 
 def body_motion_inputs(body_model: BodyModel, shape: Any, motion: Motion,

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from gnngarment.body.skeleton import NUM_JOINTS
 from gnngarment.data.cache import (
     CacheError,
     SequenceRecord,
@@ -137,10 +138,19 @@ class PreparedDataset:
         edge_index = hierarchy.edge_index
         edges = torch.from_numpy(edge_index[:, edge_index[0] < edge_index[1]].astype(np.int64))
         rest_inverse, rest_area = rest_triangle_frames(record.rest_pos, record.faces)
+        # Both cache builders store the transferred body weights; a cache without them
+        # cannot recompute them (it keeps no body mesh): the pair then has none, and a
+        # model with the ``body`` weight prior rejects it by name.
+        body_weights = (None if record.body_weights is None
+                        else torch.from_numpy(record.body_weights.astype(np.float32)))
+        if body_weights is not None and tuple(body_weights.shape) != (len(rest), NUM_JOINTS):
+            raise CacheError(f"{self.root}/garments/{garment}.npz: body_weights has shape "
+                             f"{tuple(body_weights.shape)}, expected ({len(rest)}, {NUM_JOINTS})")
         pair = GarmentBodyPair(
             rest_pos=rest, features=torch.from_numpy(features), hierarchy=hierarchy,
             descriptor=torch.from_numpy(record.descriptor.astype(np.float32)),
-            body_distances=torch.from_numpy(body_record.distances.astype(np.float32)))
+            body_distances=torch.from_numpy(body_record.distances.astype(np.float32)),
+            body_weights=body_weights)
         mass = vertex_masses(record.rest_pos, record.faces, self.fabric_density)
         return _GarmentData(pair=pair, faces=faces, edges=edges,
                             rest_inverse=torch.from_numpy(rest_inverse.astype(np.float32)),

@@ -19,6 +19,9 @@ class GarmentBodyPair:
         hierarchy: the garment's pooling hierarchy (topology only).
         descriptor: ``(N*,)`` Nyström style descriptor.
         body_distances: ``(N_b', 24)`` body-shape feature ``D``.
+        body_weights: ``(N, 24)`` the body's skinning weights transferred to the garment's
+            rest vertices (rows sum to 1; ``transfer_body_weights``): the ``body`` weight
+            prior's starting point. ``None`` where unknown (models with prior ``none``).
     """
 
     rest_pos: torch.Tensor
@@ -26,3 +29,4 @@ class GarmentBodyPair:
     hierarchy: PoolHierarchy
     descriptor: torch.Tensor
     body_distances: torch.Tensor
+    body_weights: torch.Tensor | None = None

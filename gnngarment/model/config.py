@@ -13,6 +13,11 @@ POOLING_METHODS = ("structure", "topk", "sag", "asap")
 #: reference). Both compute the same function with the same parameters.
 ATTENTION_IMPLEMENTATIONS = ("csr", "pyg")
 
+#: Priors of the skinning-weight head (Eq. 6): ``body`` starts from the garment's
+#: transferred body skinning weights and learns a gated correction; ``none`` is the
+#: paper's head, a plain softmax of the learned logits.
+WEIGHT_PRIORS = ("body", "none")
+
 
 @dataclass
 class ModelConfig:
@@ -37,6 +42,12 @@ class ModelConfig:
         window: ``m``, frames of motion history seen by the LSTMs.
         dropout: attention dropout of the GATs (0 = none).
         attention: one of :data:`ATTENTION_IMPLEMENTATIONS`; checkpoints load into either.
+        weight_prior: one of :data:`WEIGHT_PRIORS`. ``body``: ``W = softmax(log(max(W_body,
+            1e-6)) + g · logits)`` with the garment's transferred body skinning weights
+            ``W_body`` (``GarmentBodyPair.body_weights``) and a learnable gate ``g``
+            initialised to 0, so the untrained head is exactly body skinning and training
+            learns the correction. ``none``: ``W = softmax(logits)`` (the paper's head;
+            what checkpoints saved before this setting existed load as).
     """
 
     garment_channels: list[int] = field(default_factory=lambda: [32, 64, 128, 128])
@@ -56,6 +67,7 @@ class ModelConfig:
     window: int = 5
     dropout: float = 0.0
     attention: str = "csr"
+    weight_prior: str = "body"
 
     @property
     def feature_channels(self) -> int:
@@ -83,6 +95,9 @@ class ModelConfig:
         if self.attention not in ATTENTION_IMPLEMENTATIONS:
             raise ValueError(f"attention must be one of {ATTENTION_IMPLEMENTATIONS}, "
                              f"got '{self.attention}'")
+        if self.weight_prior not in WEIGHT_PRIORS:
+            raise ValueError(f"weight_prior must be one of {WEIGHT_PRIORS}, "
+                             f"got '{self.weight_prior}'")
         if not 0 <= self.levels <= 6:
             raise ValueError(f"levels must be in 0..6, got {self.levels}")
         if not 0 < self.pooling_ratio < 1:

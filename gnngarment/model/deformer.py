@@ -26,6 +26,7 @@ from gnngarment.model.garment_encoder import GarmentGraphEncoder
 from gnngarment.model.graph_levels import GraphLevels, stack_hierarchies
 from gnngarment.model.motion_encoder import MotionEncoder
 from gnngarment.model.multilevel_processor import MultilevelProcessor
+from gnngarment.model.skinning_weight_head import SkinningWeightHead, body_prior_logits
 from gnngarment.model.style_encoder import StyleEncoder
 
 #: Scale of the supervised submodule's initial output weights (see ``__init__``).
@@ -44,12 +45,15 @@ class DeformerContext:
         rest_pos: ``(ΣN, 3)``.
         ptr: ``(P + 1,)`` vertex offsets of the pairs.
         hierarchies: one per pair.
+        body_weights: ``(ΣN, 24)`` the pairs' transferred body skinning weights (the
+            ``body`` weight prior), or ``None`` when the model has no prior.
     """
 
     fused: torch.Tensor
     rest_pos: torch.Tensor
     ptr: list[int]
     hierarchies: list[PoolHierarchy]
+    body_weights: torch.Tensor | None = None
     _graphs: dict[int, GraphLevels] = field(default_factory=dict, repr=False)
 
     @property
@@ -109,6 +113,7 @@ class GarmentDeformer(nn.Module):
                                           config.motion_layers)
         self.velocity_encoder = MotionEncoder(3 * config.body_vertices, width * NUM_JOINTS,
                                               config.motion_layers)
+        self.weight_head = SkinningWeightHead(body_prior=config.weight_prior == "body")
 
         def processor() -> MultilevelProcessor:
             return MultilevelProcessor(width * NUM_JOINTS, config.processor_channels,
@@ -154,8 +159,12 @@ class GarmentDeformer(nn.Module):
         garment = self.garment_encoder(features, edge_index, style[pair_of_vertex])
         body = self.body_encoder(torch.stack([pair.body_distances for pair in pairs]))
         fused = garment * body[pair_of_vertex]
+        # Checked above: every pair has them when the head has the prior.
+        body_weights = (torch.cat([p.body_weights for p in pairs])
+                        if self.weight_head.body_prior else None)
         return DeformerContext(fused=fused, rest_pos=torch.cat([p.rest_pos for p in pairs]),
-                               ptr=_offsets(sizes), hierarchies=[p.hierarchy for p in pairs])
+                               ptr=_offsets(sizes), hierarchies=[p.hierarchy for p in pairs],
+                               body_weights=body_weights)
 
     # ---------------------------------------------------------------- per frame
     def forward(self, context: DeformerContext, motion_windows: torch.Tensor,
@@ -182,8 +191,9 @@ class GarmentDeformer(nn.Module):
         weights, processor_input = [], []
         for p in range(pairs):
             fused = context.fused[context.ptr[p]:context.ptr[p + 1]]           # (N, S, F)
-            logits = torch.einsum("nsf,bf->bns", fused, pose_code[p])          # Eq. 6
-            weights.append(torch.softmax(logits, dim=-1).flatten(0, 1))
+            prior = (None if context.body_weights is None else
+                     body_prior_logits(context.body_weights[context.ptr[p]:context.ptr[p + 1]]))
+            weights.append(self.weight_head(fused, pose_code[p], prior).flatten(0, 1))  # Eq. 6
             processor_input.append(
                 (fused.flatten(1)[None] * velocity_code[p][:, None, :]).flatten(0, 1))  # Eq. 7
         weights_all = torch.cat(weights)
@@ -240,9 +250,22 @@ def _check_pair(index: int, pair: GarmentBodyPair, config: ModelConfig) -> None:
             raise ValueError(f"pair {index}: {name} has shape {actual}, expected {shape}")
         if not torch.isfinite(getattr(pair, name)).all():
             raise ValueError(f"pair {index}: {name} contains NaN or inf")
+    if config.weight_prior == "body":
+        _check_body_weights(index, pair.body_weights, n)
     if pair.hierarchy.num_vertices != n:
         raise ValueError(f"pair {index}: hierarchy has {pair.hierarchy.num_vertices} vertices, "
                          f"garment has {n}")
+
+
+def _check_body_weights(index: int, body_weights: torch.Tensor | None, n: int) -> None:
+    if body_weights is None:
+        raise ValueError(f"pair {index}: body_weights is missing; weight_prior 'body' needs "
+                         f"the garment's transferred body skinning weights ({n}, {NUM_JOINTS})")
+    if tuple(body_weights.shape) != (n, NUM_JOINTS):
+        raise ValueError(f"pair {index}: body_weights has shape {tuple(body_weights.shape)}, "
+                         f"expected {(n, NUM_JOINTS)}")
+    if not torch.isfinite(body_weights).all():
+        raise ValueError(f"pair {index}: body_weights contains NaN or inf")
 
 
 def _check_frames(motion: torch.Tensor, velocity: torch.Tensor, transforms: torch.Tensor,

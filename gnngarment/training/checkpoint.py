@@ -50,10 +50,26 @@ def model_payload(model: GarmentDeformer) -> dict[str, Any]:
             "use_physics": model.use_physics}
 
 
+#: Settings added to :class:`ModelConfig` after checkpoints were first saved, with the
+#: value that reproduces the models saved without them (not the current default).
+LEGACY_MODEL_SETTINGS = {"weight_prior": "none"}
+
+
+def stored_model_config(stored: dict[str, Any], source: str = "<checkpoint>") -> ModelConfig:
+    """The :class:`ModelConfig` of a checkpoint's ``model_config`` dict; settings it
+    predates take their :data:`LEGACY_MODEL_SETTINGS` value, so old models keep their
+    behaviour.
+
+    Raises:
+        ConfigError: unknown key or wrong type (names ``source``).
+    """
+    return merge_config(ModelConfig, {**LEGACY_MODEL_SETTINGS, **stored}, source=source)
+
+
 def load_model(path: str | Path) -> GarmentDeformer:
     """Rebuild a model from a checkpoint, in eval mode."""
     payload = load_checkpoint(path)
-    config = merge_config(ModelConfig, payload["model_config"], source=str(path))
+    config = stored_model_config(payload["model_config"], source=str(path))
     model = GarmentDeformer(config)
     model.load_state_dict(payload["model_state"])
     model.use_physics = bool(payload.get("use_physics", False))

@@ -16,10 +16,13 @@ from tests.attribution.conftest import build
 
 def body_inputs(body_vertices: int, frames: int = 4) -> tuple[BodyShapeInputs, BodyMotionInputs]:
     rng = np.random.default_rng(2)
+    skin_rng = np.random.default_rng(3)  # its own stream: the motion stays as it was
     shape = BodyShapeInputs(joints=rng.normal(scale=0.3, size=(24, 3)).astype(np.float32),
                             distances=rng.random((body_vertices, 24)).astype(np.float32),
-                            subset=np.arange(body_vertices), rest_vertices=np.zeros((40, 3)),
-                            faces=np.zeros((0, 3), np.int64))
+                            subset=np.arange(body_vertices),
+                            rest_vertices=skin_rng.normal(scale=0.3, size=(40, 3)),
+                            faces=np.zeros((0, 3), np.int64),
+                            skinning_weights=skin_rng.dirichlet(np.ones(24), size=40))
     motion = BodyMotionInputs(
         motion_features=(rng.normal(size=(frames, 75)) * 0.2).astype(np.float32),
         velocities=(rng.normal(size=(frames, body_vertices, 3)) * 0.1).astype(np.float32),

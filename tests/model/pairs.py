@@ -29,7 +29,17 @@ def make_pair(pos: np.ndarray, faces: np.ndarray, config: ModelConfig, seed: int
         hierarchy=prepared.hierarchy,
         descriptor=torch.tensor(prepared.descriptor, dtype=torch.float32),
         body_distances=torch.tensor(rng.random((config.body_vertices, 24)), dtype=torch.float32),
+        body_weights=nearest_joint_weights(pos, joints),
     )
+
+
+def nearest_joint_weights(pos: np.ndarray, joints: np.ndarray, scale: float = 0.1
+                          ) -> torch.Tensor:
+    """``(N, 24)`` stand-in body skinning weights: a softmax of minus the distance to the
+    joints over ``scale`` metres (a function of position, so relabelling permutes it)."""
+    distance = torch.cdist(torch.as_tensor(pos, dtype=torch.float64),
+                           torch.as_tensor(joints, dtype=torch.float64))
+    return torch.softmax(-distance / scale, dim=-1).float()
 
 
 def frame_inputs(config: ModelConfig, pairs: int, frames: int, seed: int = 0,

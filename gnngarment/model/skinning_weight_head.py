@@ -1,0 +1,52 @@
+"""Skinning weights from the fused features (blueprint Eq. 6), optionally on a
+body-skinning prior."""
+
+from __future__ import annotations
+
+import torch
+from torch import nn
+
+#: Smallest body weight the prior's logarithm sees: joints the body gives no weight
+#: start at ``log(1e-6) ≈ −13.8``, far below, but still reachable by training.
+BODY_WEIGHT_FLOOR = 1e-6
+
+
+def body_prior_logits(body_weights: torch.Tensor) -> torch.Tensor:
+    """``log(max(W_body, 1e-6))``: logits whose softmax is the body weights (up to the
+    floor's renormalisation).
+
+    Shapes: ``(N, 24)`` → ``(N, 24)``.
+    """
+    return torch.log(body_weights.clamp_min(BODY_WEIGHT_FLOOR))
+
+
+class SkinningWeightHead(nn.Module):
+    """``W = softmax_S(X^fuse · E^t1)`` (Eq. 6), or with ``body_prior``
+    ``W = softmax_S(log(max(W_body, 1e-6)) + g · X^fuse · E^t1)``.
+
+    The gate ``g`` is one learnable scalar initialised to 0: the untrained head returns
+    the body's skinning weights exactly and training learns a correction. (At ``g = 0``
+    the pose code receives no gradient; the gate does, and after the first step so does
+    everything before it.) Without the prior the module has no parameters, so state
+    dicts saved before the prior existed load unchanged.
+
+    Args:
+        body_prior: add the body-skinning prior and its gate.
+    """
+
+    def __init__(self, body_prior: bool):
+        super().__init__()
+        self.body_prior = body_prior
+        self.gate = nn.Parameter(torch.zeros(())) if body_prior else None
+
+    def forward(self, fused: torch.Tensor, pose_code: torch.Tensor,
+                prior_logits: torch.Tensor | None = None) -> torch.Tensor:
+        """Shapes: fused ``(N, S, F)``, pose_code ``(B, F)``, prior_logits ``(N, S)``
+        (:func:`body_prior_logits`; required with the prior) → ``(B, N, S)`` weights,
+        rows summing to 1."""
+        logits = torch.einsum("nsf,bf->bns", fused, pose_code)
+        if self.gate is not None:
+            if prior_logits is None:
+                raise ValueError("the body-skinning prior needs prior_logits (N, S)")
+            logits = prior_logits[None] + self.gate * logits
+        return torch.softmax(logits, dim=-1)

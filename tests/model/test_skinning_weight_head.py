@@ -1,0 +1,162 @@
+"""The skinning-weight head (Eq. 6) and its body-skinning prior."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, replace
+
+import pytest
+import torch
+
+from gnngarment.body.skinning import skin
+from gnngarment.model import GarmentDeformer
+from gnngarment.model.skinning_weight_head import (
+    BODY_WEIGHT_FLOOR,
+    SkinningWeightHead,
+    body_prior_logits,
+)
+from gnngarment.training.checkpoint import load_model, model_payload, save_checkpoint
+from tests.meshes import random_disk, tube
+from tests.model.pairs import frame_inputs, make_pair, tiny_config
+
+
+@pytest.fixture(scope="module")
+def garment():
+    return random_disk(120, 7)
+
+
+def build(seed: int = 0, **overrides) -> GarmentDeformer:
+    torch.manual_seed(seed)
+    return GarmentDeformer(tiny_config(**overrides)).eval()
+
+
+def floored(weights: torch.Tensor) -> torch.Tensor:
+    weights = weights.clamp_min(BODY_WEIGHT_FLOOR)
+    return weights / weights.sum(-1, keepdim=True)
+
+
+def test_untrained_body_prior_is_body_skinning(garment) -> None:
+    model = build()
+    pair = make_pair(*garment, model.config)
+    pair.body_weights[:5] = torch.eye(24)[:5]  # exact zeros meet the floor
+    motion, velocity, transforms = frame_inputs(model.config, 1, 3, seed=2)
+    out = model(model.prepare([pair]), motion, velocity, transforms)
+
+    expected = floored(pair.body_weights).repeat(3, 1)
+    torch.testing.assert_close(out.weights, expected, atol=1e-5, rtol=0)
+    # The floor moves at most 23 · 1e-6 of a one-hot row onto the other joints.
+    torch.testing.assert_close(out.weights[:5], torch.eye(24)[:5], atol=24 * BODY_WEIGHT_FLOOR,
+                               rtol=0)
+    lbs = skin(pair.rest_pos.repeat(3, 1), out.blend_shapes, expected,
+               transforms.flatten(0, 1), batch=out.item)
+    torch.testing.assert_close(out.posed, lbs, atol=1e-5, rtol=0)
+
+
+def test_body_prior_is_per_pair_in_a_batch(garment) -> None:
+    model = build()
+    pairs = [make_pair(*garment, model.config, seed=1), make_pair(*tube(6, 8), model.config,
+                                                                seed=2)]
+    out = model(model.prepare(pairs), *frame_inputs(model.config, 2, 2))
+    for p, part in enumerate(out.split("weights", [120, 48], 2)):
+        torch.testing.assert_close(part, floored(pairs[p].body_weights).expand(2, -1, -1),
+                                   atol=1e-5, rtol=0)
+
+
+def test_no_prior_is_the_plain_softmax_head(garment) -> None:
+    """``none`` is the paper's head: no parameter, ``softmax(X^fuse · E^t1)``, and the
+    pair's body weights are ignored."""
+    model = build(weight_prior="none")
+    assert not any("weight_head" in name for name, _ in model.named_parameters())
+    pair = make_pair(*garment, model.config)
+    motion, velocity, transforms = frame_inputs(model.config, 1, 2)
+    context = model.prepare([pair])
+    assert context.body_weights is None
+    out = model(context, motion, velocity, transforms)
+    pose_code, _ = model.pose_encoder(motion.flatten(0, 1))
+    expected = torch.softmax(torch.einsum("nsf,bf->bns", context.fused, pose_code), -1)
+    torch.testing.assert_close(out.weights, expected.flatten(0, 1))
+    without = model(model.prepare([replace(pair, body_weights=None)]), motion, velocity,
+                    transforms)
+    assert torch.equal(out.posed, without.posed)
+
+
+def test_gradients_reach_the_gate_and_then_everything(garment) -> None:
+    model = build()
+    model.train()
+    pair = make_pair(*garment, model.config)
+    inputs = frame_inputs(model.config, 1, 2)
+    target = torch.randn(2 * 120, 3)
+
+    out = model(model.prepare([pair]), *inputs)
+    ((out.posed - target) ** 2).mean().backward()
+    gate = model.weight_head.gate
+    assert gate is not None and gate.grad is not None and gate.grad.abs() > 0
+    for name, parameter in model.named_parameters():  # the fused features train from step 1
+        if name.startswith(("garment_encoder", "style_encoder", "body_encoder")):
+            assert parameter.grad is not None and parameter.grad.abs().sum() > 0, name
+    # At g = 0 the pose code only reaches W through the gate; once the gate moves, every
+    # supervised parameter, E^t1 included, receives a gradient.
+    assert all(p.grad is None or p.grad.abs().sum() == 0
+               for p in model.pose_encoder.parameters())
+    optimiser = torch.optim.Adamax(model.parameters(), lr=1e-2)
+    optimiser.step()
+    optimiser.zero_grad(set_to_none=True)
+    out = model(model.prepare([pair]), *inputs)
+    ((out.posed - target) ** 2).mean().backward()
+    assert gate.item() != 0
+    for name, parameter in model.named_parameters():
+        if not name.startswith("physics_processor"):
+            assert parameter.grad is not None and parameter.grad.abs().sum() > 0, name
+
+
+def test_head_alone_matches_its_formula() -> None:
+    generator = torch.Generator().manual_seed(0)
+    fused, code = torch.randn(5, 24, 4, generator=generator), torch.randn(3, 4, generator=generator)
+    prior = torch.softmax(torch.randn(5, 24, generator=generator), -1)
+    head = SkinningWeightHead(body_prior=True)
+    with torch.no_grad():
+        head.gate.fill_(0.5)
+    expected = torch.softmax(torch.log(prior) + 0.5 * torch.einsum("nsf,bf->bns", fused, code),
+                             -1)
+    torch.testing.assert_close(head(fused, code, body_prior_logits(prior)), expected)
+    with pytest.raises(ValueError, match="prior_logits"):
+        head(fused, code)
+
+
+@pytest.mark.parametrize("body_weights,message", [
+    (None, "body_weights is missing"),
+    (torch.full((7, 24), 1 / 24), "body_weights has shape"),
+    (torch.full((120, 24), float("nan")), "body_weights contains NaN"),
+])
+def test_body_prior_needs_body_weights(garment, body_weights, message: str) -> None:
+    model = build()
+    pair = replace(make_pair(*garment, model.config), body_weights=body_weights)
+    with pytest.raises(ValueError, match=message):
+        model.prepare([pair])
+
+
+def test_unknown_prior_is_rejected() -> None:
+    with pytest.raises(ValueError, match="weight_prior"):
+        GarmentDeformer(tiny_config(weight_prior="smpl"))
+
+
+def test_checkpoints_keep_their_prior(garment, tmp_path) -> None:
+    """A checkpoint saved before ``weight_prior`` existed has no such key (and no gate):
+    it loads as ``none`` and predicts as before. A new one keeps its own prior."""
+    old = build(seed=3, weight_prior="none")
+    payload = model_payload(old)
+    del payload["model_config"]["weight_prior"]
+    save_checkpoint(tmp_path / "old.pt", payload)
+    loaded = load_model(tmp_path / "old.pt")
+    assert loaded.config.weight_prior == "none"
+    pair = make_pair(*garment, old.config)
+    inputs = frame_inputs(old.config, 1, 2)
+    assert torch.equal(old(old.prepare([pair]), *inputs).posed,
+                       loaded(loaded.prepare([pair]), *inputs).posed)
+
+    new = build(seed=3)
+    with torch.no_grad():
+        new.weight_head.gate.fill_(0.25)
+    save_checkpoint(tmp_path / "new.pt", model_payload(new))
+    reloaded = load_model(tmp_path / "new.pt")
+    assert asdict(reloaded.config) == asdict(new.config)
+    assert reloaded.weight_head.gate.item() == 0.25
