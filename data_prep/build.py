@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from data_prep.config import DataConfig
-from gnngarment.geometry.files import TEMP_SUFFIX, atomic_write, atomic_write_bytes
+from gnngarment.geometry.files import FolderLock, atomic_write_bytes
 
 #: Bumped when the builder's output changes for the same config (forces a rebuild).
 BUILDER_VERSION = 1
@@ -198,51 +198,145 @@ def prepare_body(root: Path, plan: BodyPlan, config: DataConfig) -> None:
                                 distances=inputs.distances, subset=inputs.subset))
 
 
-def make_garment(design: DesignPlan, body: BodyPlan) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The design fitted to the body's rest pose: ``pos (N, 3)``, ``faces (F, 3)`` and the
-    indices of the vertices pinned to the pelvis (empty unless waist-supported).
+def is_strapless(style: Any) -> bool:
+    """Whether a sampled style has no straps or sleeves to hang from (a tube top, a
+    strapless dress or jumpsuit)."""
+    return "strapless" in (getattr(style, "sleeves", None), getattr(style, "kind", None))
+
+
+@dataclass(frozen=True)
+class GarmentDesign:
+    """A design fitted to a body's rest pose, before draping.
+
+    Attributes:
+        pos: ``(N, 3)`` design positions [m]; faces ``(F, 3)``.
+        pinned: ``(P,)`` vertices held by the body: the waist ring of a skirt or trousers,
+            the elastic top band of a strapless design; empty otherwise.
+        pin_joint: the joint whose rigid motion the pinned vertices follow (-1: none).
+    """
+
+    pos: np.ndarray
+    faces: np.ndarray
+    pinned: np.ndarray
+    pin_joint: int
+
+
+def make_garment(design: DesignPlan, body: BodyPlan) -> GarmentDesign:
+    """The design fitted to the body's rest pose (undraped).
 
     A design is its type, a style drawn from the design's seed and a resolution: the
     same design on every body (fitted to each), as CLOTH3D refits a garment per body.
+    Skirts and trousers hang from a waist ring that follows the pelvis; a strapless top,
+    dress or jumpsuit has an elastic top band that follows the chest joint it sits on
+    (without it, 17 of 74 benchmark sequences slid down the body).
     """
     from data_prep.garments import GARMENT_TYPES, BodyFrame
     from data_prep.garments import make_garment as build_garment
 
-    rest = _body_model().rest(_shape(body))
+    body_model = _body_model()
+    rest = body_model.rest(_shape(body))
     frame = BodyFrame(vertices=rest.vertices.numpy(), faces=rest.faces,
                       joints=rest.joints.numpy())
     style = GARMENT_TYPES[design.garment_type][0].sample(np.random.default_rng(design.seed))
     garment = build_garment(frame, design.garment_type, style,
                             target_vertices=design.vertices, seed=design.seed,
                             name=design.name)
-    pinned = (np.asarray(garment.pin_candidates, dtype=np.int64)
-              if design.garment_type in WAIST_SUPPORTED else np.zeros(0, dtype=np.int64))
-    return garment.pos, garment.faces, pinned
+    band = np.asarray(garment.pin_candidates, dtype=np.int64)
+    if design.garment_type in WAIST_SUPPORTED:
+        return GarmentDesign(garment.pos, garment.faces, band, 0)
+    if is_strapless(style):
+        from gnngarment.evaluation.baselines import transfer_body_weights
+
+        weights = transfer_body_weights(garment.pos[band], rest.vertices.numpy(),
+                                        body_model.skinning_weights())
+        return GarmentDesign(garment.pos, garment.faces, band, int(weights.sum(0).argmax()))
+    return GarmentDesign(garment.pos, garment.faces, np.zeros(0, dtype=np.int64), -1)
 
 
-def prepare_garment_record(root: Path, design: DesignPlan, body: BodyPlan,
-                           config: DataConfig) -> dict[str, Any]:
-    """Write ``garments/<design>_<body>.npz`` and its topology; returns its info."""
-    from gnngarment.data.cache import GarmentRecord, topology_key, write_garment, write_topology
-    from gnngarment.evaluation.baselines import transfer_body_weights
-    from gnngarment.geometry.prepare import GarmentPreparationConfig, prepare_garment
+def read_pins(root: Path, garment: str) -> tuple[np.ndarray, int]:
+    """The pinned vertices ``(P,)`` of a cache garment and the joint they follow."""
+    pins = json.loads((root / "garments" / f"{garment}.pins.json").read_text())
+    return np.asarray(pins["vertices"], dtype=np.int64), int(pins["joint"])
 
-    pos, faces, pinned = make_garment(design, body)
+
+def drape_and_prepare_garment(task: tuple[str, DesignPlan, BodyPlan, DataConfig, str]
+                              ) -> dict[str, Any]:
+    """Worker: fit a design to a body, drape it on the still rest body (the template,
+    DESIGN.md), and write ``garments/<design>_<body>.npz`` (rest_pos = the drape,
+    design_pos = the design), its pins and its topology. Returns a status dict (never
+    raises for a failed drape: the garment and its sequences are reported and left out).
+    """
+    root_text, design, body, config, inputs_hash = task
+    root = Path(root_text)
     name = f"{design.name}_{body.name}"
-    prepared = prepare_garment(pos, faces, GarmentPreparationConfig(
-        levels=config.levels, landmarks=config.landmarks), source=name)
-    key = topology_key(faces)
-    if not (root / "topologies" / f"{key}.npz").is_file():
-        write_topology(root, key, prepared.hierarchy)
-    body_model = _body_model()
-    rest = body_model.rest(_shape(body))
-    weights = transfer_body_weights(pos, rest.vertices.numpy(), body_model.skinning_weights())
-    write_garment(root, GarmentRecord(name=name, rest_pos=pos, faces=faces,
-                                      descriptor=prepared.descriptor, topology=key,
-                                      garment_type=design.garment_type, body=body.name,
-                                      body_weights=weights))
-    atomic_write(root / "garments" / f"{name}.pinned.npy", lambda stream: np.save(stream, pinned))
-    return {"vertices": len(pos), "faces": len(faces), "pinned": len(pinned)}
+    started = time.perf_counter()
+    try:
+        import torch
+
+        from data_prep.simulate import SimulationFailed, drape_garment, load_simulation_settings
+        from gnngarment.data.cache import (
+            GarmentRecord,
+            topology_key,
+            write_garment,
+            write_topology,
+        )
+        from gnngarment.evaluation.baselines import transfer_body_weights
+        from gnngarment.geometry.prepare import GarmentPreparationConfig, prepare_garment
+
+        torch.set_num_threads(1)
+        body_model = _body_model()
+        rest = body_model.rest(_shape(body))
+        body_vertices = rest.vertices.numpy()
+        made = make_garment(design, body)
+        try:
+            drape = drape_garment(made.pos, made.faces, body_vertices, body_model.faces,
+                                  config.fps, fabric=design.fabric,
+                                  pinned=made.pinned if len(made.pinned) else None,
+                                  settings=load_simulation_settings(config.simulation),
+                                  max_frames=config.drape_frames,
+                                  rest_speed=config.drape_rest_speed)
+        except SimulationFailed as error:
+            return _garment_left_out(root, name, inputs_hash, f"drape: {error}", started)
+        samples = body_model.feature_vertex_indices(config.collision_points)
+        off = left_the_body(drape.positions[None], body_vertices[samples][None],
+                            rest=made.pos)
+        if off:
+            return _garment_left_out(root, name, inputs_hash, f"drape: {off}", started)
+        pos = drape.positions.astype(np.float64)
+        prepared = prepare_garment(pos, made.faces, GarmentPreparationConfig(
+            levels=config.levels, landmarks=config.landmarks), source=name)
+        key = topology_key(made.faces)
+        if not (root / "topologies" / f"{key}.npz").is_file():
+            write_topology(root, key, prepared.hierarchy)
+        weights = transfer_body_weights(pos, body_vertices, body_model.skinning_weights())
+        atomic_write_bytes(root / "garments" / f"{name}.pins.json", json.dumps(
+            {"vertices": made.pinned.tolist(), "joint": made.pin_joint}).encode())
+        write_garment(root, GarmentRecord(name=name, rest_pos=pos, faces=made.faces,
+                                          descriptor=prepared.descriptor, topology=key,
+                                          garment_type=design.garment_type, body=body.name,
+                                          body_weights=weights, design_pos=made.pos))
+        atomic_write_bytes(root / "garments" / f"{name}.hash", inputs_hash.encode())
+        return {"name": name, "ok": True, "vertices": len(pos), "faces": len(made.faces),
+                "pinned": len(made.pinned), "drape_frames": drape.frames,
+                "drape_settled": drape.settled,
+                "drape_last_speed_mm": 1000 * drape.last_speed,
+                "drape_mean_displacement_mm": 1000 * drape.mean_displacement,
+                "seconds": time.perf_counter() - started}
+    except Exception as error:  # a broken design on this body: report, don't kill the build
+        import traceback
+
+        where = traceback.extract_tb(error.__traceback__)[-1]
+        return {"name": name, "ok": False,
+                "reason": f"{type(error).__name__}: {error} ({Path(where.filename).name}:"
+                          f"{where.lineno})", "seconds": time.perf_counter() - started}
+
+
+def _garment_left_out(root: Path, name: str, inputs_hash: str, reason: str,
+                      started: float) -> dict[str, Any]:
+    atomic_write_bytes(root / "garments" / f"{name}.failed",
+                       json.dumps({"inputs_hash": inputs_hash, "reason": reason}).encode())
+    return {"name": name, "ok": False, "reason": reason,
+            "seconds": time.perf_counter() - started}
 
 
 def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[str, Any]:
@@ -271,12 +365,12 @@ def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[s
         body_vertices = posed.vertices.numpy()
         transforms = posed.joint_transforms.numpy()
         garment = read_garment(root, plan.garment)
-        pinned = np.load(root / "garments" / f"{plan.garment}.pinned.npy")
+        pinned, pin_joint = read_pins(root, plan.garment)
         pin_targets = None
         if len(pinned):
-            # The waist ring follows the pelvis rigidly.
+            # A waist ring or top band follows its joint rigidly.
             rest_h = np.concatenate([garment.rest_pos[pinned], np.ones((len(pinned), 1))], 1)
-            pin_targets = np.einsum("tab,pb->tpa", transforms[:, 0], rest_h)[..., :3]
+            pin_targets = np.einsum("tab,pb->tpa", transforms[:, pin_joint], rest_h)[..., :3]
         settings = load_simulation_settings(config.simulation)
         if config.settle_frames >= 0:
             settings.settle_frames = config.settle_frames
@@ -337,14 +431,35 @@ def _left_out(root: Path, name: str, inputs_hash: str, reason: str,
             "seconds": time.perf_counter() - started}
 
 
-def _known_failure(root: Path, name: str, inputs_hash: str) -> str | None:
-    """The recorded reason a sequence with these inputs failed before, if any."""
-    path = root / "sequences" / f"{name}.failed"
+def _known_failure(root: Path, name: str, inputs_hash: str,
+                   folder: str = "sequences") -> str | None:
+    """The recorded reason a sequence (or, with ``folder="garments"``, a garment's drape)
+    with these inputs failed before, if any."""
+    path = root / folder / f"{name}.failed"
     try:
         record = json.loads(path.read_text())
     except (OSError, ValueError):
         return None
     return record.get("reason") if record.get("inputs_hash") == inputs_hash else None
+
+
+def _garment_done(root: Path, name: str, inputs_hash: str) -> bool:
+    hash_file = root / "garments" / f"{name}.hash"
+    return ((root / "garments" / f"{name}.npz").is_file()
+            and (root / "garments" / f"{name}.pins.json").is_file()
+            and hash_file.is_file() and hash_file.read_text() == inputs_hash)
+
+
+def _garment_summary(root: Path, name: str) -> dict[str, Any]:
+    """What the build report says of a garment draped by an earlier run."""
+    from gnngarment.data.cache import read_garment
+
+    record = read_garment(root, name)
+    shift = (np.linalg.norm(record.rest_pos - record.design_pos, axis=1).mean()
+             if record.design_pos is not None else float("nan"))
+    return {"name": name, "ok": True, "vertices": len(record.rest_pos),
+            "faces": len(record.faces), "pinned": len(read_pins(root, name)[0]),
+            "drape_mean_displacement_mm": 1000 * float(shift)}
 
 
 def _sequence_done(root: Path, name: str, inputs_hash: str) -> bool:
@@ -359,19 +474,31 @@ def build_dataset(config: DataConfig, workers: int | None = None,
 
     Returns:
         The build report (also written to ``build_report.json``).
+
+    Raises:
+        FolderBusyError: another build holds ``config.output``.
     """
+    root = Path(config.output)
+    with FolderLock(root, "`gnngarment prepare`") as lock:
+        # A killed build can leave the temporary file of a write it did not finish: with
+        # the lock held no other build is writing here, so those (and only those names)
+        # are stale.
+        lock.remove_stale_temporaries(CACHE_FOLDERS)
+        return _build_locked(root, config, workers, log)
+
+
+#: The folders a build writes (stale temporary files are looked for only there).
+CACHE_FOLDERS = ("raw", "garments", "sequences", "topologies", "bodies", ".")
+
+
+def _build_locked(root: Path, config: DataConfig, workers: int | None,
+                  log: Callable[[str], None]) -> dict[str, Any]:
     from tqdm import tqdm
 
     from data_prep.simulate import load_simulation_settings
     from gnngarment.data.cache import write_manifest
 
-    root = Path(config.output)
-    root.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
-    # A killed build can leave the temporary file of a write it did not finish; no
-    # reader looks at those names, and this build will write the file again.
-    for stale in root.rglob(f".*{TEMP_SUFFIX}"):
-        stale.unlink(missing_ok=True)
     plans = plan_dataset(config)
     settings = load_simulation_settings(config.simulation)
     # What decides a sequence's content: not where the dataset lives, how many
@@ -386,43 +513,68 @@ def build_dataset(config: DataConfig, workers: int | None = None,
     garments: dict[str, tuple[DesignPlan, BodyPlan]] = {}
     for plan in plans:
         garments.setdefault(plan.garment, (plan.design, plan.body))
-    garment_info, failed_garments = {}, {}
-    for name, (design, body) in tqdm(garments.items(), desc="garments", unit="garment"):
-        try:
-            garment_info[name] = prepare_garment_record(root, design, body, config)
-        except Exception as error:  # report and leave its sequences out
-            failed_garments[name] = f"{type(error).__name__}: {error}"
-            log(f"garment {name} left out: {failed_garments[name]}")
+    drape_tasks, garment_info, failed_garments = [], {}, {}
+    for name, (design, body) in garments.items():
+        garment_hash = _hash({**base_hash, "design": asdict(design), "body": asdict(body)})
+        if _garment_done(root, name, garment_hash):
+            garment_info[name] = _garment_summary(root, name)
+            continue
+        reason = _known_failure(root, name, garment_hash, folder="garments")
+        if reason is not None:
+            failed_garments[name] = reason
+            continue
+        drape_tasks.append((str(root), design, body, config, garment_hash))
 
-    tasks, skipped = [], 0
-    known_failures: dict[str, str] = {}
-    for plan in plans:
-        if plan.garment in failed_garments:
-            continue
-        inputs_hash = _hash({**base_hash, "plan": asdict(plan)})
-        if _sequence_done(root, plan.name, inputs_hash):
-            skipped += 1
-            continue
-        reason = _known_failure(root, plan.name, inputs_hash)
-        if reason is not None:  # same inputs failed before: it would fail again
-            known_failures[plan.name] = reason
-            continue
-        tasks.append((str(root), plan, config, inputs_hash))
     workers = workers or config.workers or os.cpu_count() or 1
-    log(f"{len(plans)} sequences planned: {skipped} already built, {len(known_failures)} "
-        f"failed before with the same inputs, {len(tasks)} to simulate with "
-        f"{min(workers, max(len(tasks), 1))} worker(s)")
-    results = []
-    if tasks:
-        _warm_up_kernels(log)
-        context = multiprocessing.get_context("spawn")
-        with context.Pool(min(workers, len(tasks))) as pool:
+    log(f"{len(garments)} garments planned: {len(garment_info)} already draped, "
+        f"{len(failed_garments)} failed before with the same inputs, {len(drape_tasks)} to "
+        "drape on their rest bodies")
+    context = multiprocessing.get_context("spawn")
+    pool = None
+    results: list[dict[str, Any]] = []
+    try:
+        if drape_tasks:
+            _warm_up_kernels(log)
+            pool = context.Pool(min(workers, len(drape_tasks)))
+            for result in tqdm(pool.imap_unordered(drape_and_prepare_garment, drape_tasks),
+                               total=len(drape_tasks), desc="draping", unit="garment"):
+                if result["ok"]:
+                    garment_info[result["name"]] = result
+                else:
+                    failed_garments[result["name"]] = result["reason"]
+                    log(f"garment {result['name']} left out: {result['reason']}")
+
+        tasks, skipped = [], 0
+        known_failures: dict[str, str] = {}
+        for plan in plans:
+            if plan.garment in failed_garments:
+                continue
+            inputs_hash = _hash({**base_hash, "plan": asdict(plan)})
+            if _sequence_done(root, plan.name, inputs_hash):
+                skipped += 1
+                continue
+            reason = _known_failure(root, plan.name, inputs_hash)
+            if reason is not None:  # same inputs failed before: it would fail again
+                known_failures[plan.name] = reason
+                continue
+            tasks.append((str(root), plan, config, inputs_hash))
+        log(f"{len(plans)} sequences planned: {skipped} already built, {len(known_failures)} "
+            f"failed before with the same inputs, {len(tasks)} to simulate with "
+            f"{min(workers, max(len(tasks), 1))} worker(s)")
+        if tasks:
+            if pool is None:
+                _warm_up_kernels(log)
+                pool = context.Pool(min(workers, len(tasks)))
             bar = tqdm(pool.imap_unordered(simulate_sequence, tasks), total=len(tasks),
                        desc="simulating", unit="sequence")
             for result in bar:
                 results.append(result)
                 if not result["ok"]:
                     log(f"sequence {result['name']} left out: {result['reason']}")
+    finally:
+        if pool is not None:
+            pool.terminate()
+            pool.join()
 
     failed = known_failures | {r["name"]: r["reason"] for r in results if not r["ok"]}
     built = [p for p in plans if p.garment not in failed_garments and p.name not in failed

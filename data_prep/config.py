@@ -39,7 +39,12 @@ class DataConfig:
             stored per frame for the collision loss and rate.
         levels, landmarks: pooling levels and Nyström landmarks of the topology cache.
         simulation: simulation settings file (``configs/simulation.yaml``).
-        settle_frames: overrides the simulation file's settle frames (-1 = keep).
+        settle_frames: overrides the simulation file's settle frames (-1 = keep): frames
+            simulated on the still first pose before a sequence's motion. Sequences
+            start from the draped template, so 0 is the usual value.
+        drape_frames: frame cap of the drape that makes every template (the design
+            settled on the still rest body).
+        drape_rest_speed: a drape is at rest when no vertex moves this far in a frame [m].
         workers: simulation processes (0 = one per core).
         splits: held-out counts.
     """
@@ -64,5 +69,40 @@ class DataConfig:
     landmarks: int = 64
     simulation: str = "configs/simulation.yaml"
     settle_frames: int = -1
+    drape_frames: int = 120
+    drape_rest_speed: float = 0.001
     workers: int = 0
     splits: SplitConfig = field(default_factory=SplitConfig)
+
+    def __post_init__(self) -> None:
+        """Check names and ranges before any work starts (a build with an unknown motion
+        would otherwise run and leave every sequence out)."""
+        from data_prep.garments import GARMENT_TYPES
+        from data_prep.simulate.fabrics import FABRICS
+        from gnngarment.body.anny_model import ANNY_PRESETS
+        from gnngarment.body.procedural import MOTION_LIBRARY
+
+        for key, names, known in (("garment_types", self.garment_types, GARMENT_TYPES),
+                                  ("motions", self.motions, MOTION_LIBRARY),
+                                  ("fabrics", self.fabrics, FABRICS),
+                                  ("body_presets", self.body_presets, ANNY_PRESETS)):
+            unknown = [name for name in names if name not in known]
+            if unknown or (not names and key != "body_presets"):
+                raise ValueError(f"key '{key}': unknown {unknown or 'empty list'}; "
+                                 f"known: {', '.join(sorted(known))}")
+        if len(self.garment_vertices) != 2 or not (
+                300 <= self.garment_vertices[0] <= self.garment_vertices[1]):
+            raise ValueError("key 'garment_vertices': expected [low, high] with 300 <= low "
+                             f"<= high, got {list(self.garment_vertices)}")
+        for key in ("fps", "motion_seconds", "drape_rest_speed"):
+            value = getattr(self, key)
+            if not value > 0 or value != value or value == float("inf"):
+                raise ValueError(f"key '{key}': must be a finite number > 0, got {value}")
+        for key in ("garments", "bodies", "motions_per_pair", "body_vertices",
+                    "collision_points", "levels", "landmarks", "drape_frames"):
+            if getattr(self, key) < 1:
+                raise ValueError(f"key '{key}': must be >= 1, got {getattr(self, key)}")
+        if self.settle_frames < -1:
+            raise ValueError(f"key 'settle_frames': must be >= -1, got {self.settle_frames}")
+        if self.workers < 0:
+            raise ValueError(f"key 'workers': must be >= 0, got {self.workers}")

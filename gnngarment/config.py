@@ -72,4 +72,8 @@ def merge_config(schema: type[T], values: Any, source: str = "<overrides>") -> T
         where = f" key '{key}'" if key else ""
         message = str(error).splitlines()[0]
         raise ConfigError(f"{source}:{where} {message}") from error
+    except ConfigError:
+        raise
+    except ValueError as error:  # a range check of the schema's __post_init__ names the key
+        raise ConfigError(f"{source}: {error}") from error
     return result  # type: ignore[return-value]

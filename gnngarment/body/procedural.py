@@ -34,14 +34,14 @@ JOINT_LIMITS_DEG: dict[str, float] = {
     "L_hip": 120.0, "R_hip": 120.0,
     "spine1": 35.0, "spine2": 35.0, "spine3": 35.0,
     "L_knee": 140.0, "R_knee": 140.0,
-    "L_ankle": 45.0, "R_ankle": 45.0,
+    "L_ankle": 55.0, "R_ankle": 55.0,
     "L_foot": 30.0, "R_foot": 30.0,
-    "neck": 40.0, "head": 40.0,
-    "L_collar": 25.0, "R_collar": 25.0,
+    "neck": 60.0, "head": 60.0,
+    "L_collar": 45.0, "R_collar": 45.0,
     "L_shoulder": 170.0, "R_shoulder": 170.0,
     "L_elbow": 145.0, "R_elbow": 145.0,
     "L_wrist": 70.0, "R_wrist": 70.0,
-    "L_hand": 40.0, "R_hand": 40.0,
+    "L_hand": 45.0, "R_hand": 45.0,
 }  # fmt: skip
 
 
@@ -284,6 +284,40 @@ def _dance(b: _Builder, speed: float, amplitude: float, rng) -> None:
     b.translation[:, 2] += e * 0.02 * a * (np.cos(2 * beat) - 1) / 2
 
 
+#: Secondary movements layered onto every motion: (joint, axis, degrees at amplitude 1).
+#: Real mocap moves the neck, head, collars, wrists and hands even while walking (a real
+#: CLOTH3D walk turns neck, collars and head 18–26°); a library that never moves them
+#: cannot teach a model that they do not move a pair of trousers. Each term is a slow
+#: sine (0.25–0.35 Hz), so its first peak (≈20°) lands within the first second after the
+#: rest hold, even in a 1.2 s clip. Axes: 0 nods / swings forward-back, 1 tilts sideways,
+#: 2 turns about the vertical.
+SECONDARY_MOTION_DEG: tuple[tuple[str, int, float], ...] = (
+    ("neck", 2, 20.0), ("neck", 0, 18.0),
+    ("head", 2, 20.0), ("head", 0, -18.0), ("head", 1, 12.0),
+    ("spine1", 1, 12.0), ("spine2", 1, -12.0), ("spine2", 0, -8.0), ("spine3", 0, -12.0),
+    ("spine3", 2, 10.0),
+    ("L_collar", 1, -20.0), ("R_collar", 1, 20.0),
+    ("L_wrist", 0, 25.0), ("R_wrist", 0, -25.0), ("L_wrist", 2, -15.0), ("R_wrist", 2, 15.0),
+    ("L_hand", 0, 22.0), ("R_hand", 0, 22.0),
+    ("L_ankle", 0, 12.0), ("R_ankle", 0, -12.0),
+    ("L_foot", 0, 20.0), ("R_foot", 0, 20.0),
+)
+
+
+def _secondary_motion(b: _Builder, amplitude: float, rng: np.random.Generator | None) -> None:
+    """Layer :data:`SECONDARY_MOTION_DEG` onto the motion in ``b`` (eased in like the
+    motion itself; tempo, phase and size varied per term by ``rng``)."""
+    t = np.maximum(b.t, 0.0)
+    for k, (joint, axis, degrees) in enumerate(SECONDARY_MOTION_DEG):
+        if rng is None:  # canonical: fixed, distinct tempi so the terms do not move in step
+            freq, phase, size = 0.25 + 0.1 * ((k * 7) % 11) / 10, 0.0, 1.0
+        else:
+            freq, phase, size = (float(rng.uniform(0.25, 0.35)), float(rng.uniform(-0.3, 0.3)),
+                                 float(rng.uniform(0.9, 1.1)))
+        b.add(joint, axis, amplitude * size * degrees * b.ease
+              * np.sin(2 * np.pi * freq * t + phase))
+
+
 @dataclasses.dataclass(frozen=True)
 class ProceduralMotion:
     """A named entry of the library."""
@@ -352,6 +386,7 @@ def make_motion(
     builder = _Builder(t=t, ease=smoothstep(t / RAMP_SECONDS), fps=float(fps))
     rng = None if seed is None else np.random.default_rng(seed)
     MOTION_LIBRARY[name].build(builder, speed, amplitude, rng)
+    _secondary_motion(builder, amplitude, rng)
     return builder.motion(name)
 
 

@@ -25,7 +25,7 @@ from gnngarment.geometry.files import atomic_write_bytes, load_npz, save_npz_ato
 from gnngarment.geometry.hierarchy import PoolHierarchy
 
 #: Bumped when the layout of any cache file changes: older caches are rebuilt.
-CACHE_FORMAT_VERSION = 1
+CACHE_FORMAT_VERSION = 2
 
 GARMENT_ARRAYS = ("rest_pos", "faces", "descriptor", "topology", "garment_type", "body")
 BODY_ARRAYS = ("joints", "distances", "subset")
@@ -54,10 +54,12 @@ def topology_key(faces: np.ndarray) -> str:
 
 @dataclass
 class GarmentRecord:
-    """``garments/<name>.npz``. Shapes: rest_pos ``(N, 3)`` metres on the rest body of
-    ``body``, faces ``(F, 3)``, descriptor ``(N*,)``; optional body_weights ``(N, 24)``,
-    the body's skinning weights transferred from the nearest body vertices (the
-    body-skinning baseline)."""
+    """``garments/<name>.npz``. Shapes: rest_pos ``(N, 3)`` metres: the template, the
+    garment as worn (draped) on the rest body of ``body`` in the rest pose, where every
+    sequence starts; faces ``(F, 3)``, descriptor ``(N*,)``; optional body_weights
+    ``(N, 24)``, the body's skinning weights transferred from the nearest body vertices
+    (the body-skinning baseline and prior); optional design_pos ``(N, 3)``, the undraped
+    design the template was draped from (provenance only: no reader learns from it)."""
 
     name: str
     rest_pos: np.ndarray
@@ -67,6 +69,7 @@ class GarmentRecord:
     garment_type: str
     body: str
     body_weights: np.ndarray | None = None
+    design_pos: np.ndarray | None = None
 
 
 @dataclass
@@ -121,6 +124,8 @@ def write_garment(root: Path, record: GarmentRecord) -> Path:
         "descriptor": record.descriptor.astype(np.float64),
         **({} if record.body_weights is None
            else {"body_weights": record.body_weights.astype(np.float32)}),
+        **({} if record.design_pos is None
+           else {"design_pos": record.design_pos.astype(np.float32)}),
         **_strings(record, ("topology", "garment_type", "body"))})
     return path
 
@@ -153,7 +158,8 @@ def read_garment(root: Path, name: str) -> GarmentRecord:
     return GarmentRecord(name=name, rest_pos=data["rest_pos"], faces=data["faces"],
                          descriptor=data["descriptor"], topology=str(data["topology"]),
                          garment_type=str(data["garment_type"]), body=str(data["body"]),
-                         body_weights=data.get("body_weights"))
+                         body_weights=data.get("body_weights"),
+                         design_pos=data.get("design_pos"))
 
 
 def read_body(root: Path, name: str) -> BodyRecord:

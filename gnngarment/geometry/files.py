@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import secrets
 import zipfile
 from collections.abc import Callable
@@ -86,3 +87,74 @@ def load_npz(path: str | Path, required: tuple[str, ...] = ()) -> dict[str, np.n
     if missing:
         raise ValueError(f"{path}: missing arrays {missing}")
     return arrays
+
+
+#: The name of a temporary file :func:`atomic_write` makes: ``.<name>.<8 hex>.tmp``.
+TEMP_NAME = re.compile(r"^\..+\.[0-9a-f]{8}" + re.escape(TEMP_SUFFIX) + r"$")
+
+
+class FolderBusyError(OSError):
+    """Another process holds the output folder's lock (the message names it)."""
+
+
+class FolderLock:
+    """An exclusive, advisory lock on an output folder for the life of a run.
+
+    A second run into the same folder is refused at once (its message names the holder's
+    pid) instead of interleaving its files with the first one's. The lock is a
+    ``.lock`` file's ``flock``: the kernel releases it when the holder dies, even by
+    kill -9, so a stale lock never blocks the next run.
+
+    Use as a context manager; :meth:`remove_stale_temporaries` is safe only while held.
+    """
+
+    def __init__(self, folder: str | Path, what: str = "run") -> None:
+        self.folder = Path(folder)
+        self.what = what
+        self._stream: BinaryIO | None = None
+
+    def __enter__(self) -> FolderLock:
+        import fcntl
+
+        self.folder.mkdir(parents=True, exist_ok=True)
+        path = self.folder / ".lock"
+        stream = open(path, "a+b")
+        try:
+            fcntl.flock(stream.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            stream.seek(0)
+            holder = stream.read().decode(errors="replace").strip() or "another process"
+            stream.close()
+            raise FolderBusyError(f"{self.folder}: another {self.what} ({holder}) is writing "
+                                  "here; wait for it to finish or choose another output "
+                                  "folder") from None
+        stream.seek(0)
+        stream.truncate()
+        stream.write(f"pid {os.getpid()}".encode())
+        stream.flush()
+        self._stream = stream
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        if self._stream is not None:
+            self._stream.close()  # closing releases the flock
+            self._stream = None
+
+    def remove_stale_temporaries(self, subfolders: tuple[str, ...]) -> int:
+        """Delete the temporary files a killed earlier run left in ``subfolders`` (only
+        names :func:`atomic_write` makes; any other file, hidden or not, is the user's).
+        Returns how many were removed."""
+        if self._stream is None:
+            raise RuntimeError("remove_stale_temporaries needs the lock held")
+        removed = 0
+        for name in subfolders:
+            folder = self.folder / name
+            if not folder.is_dir():
+                continue
+            # The folder itself only at the top ("."), its subfolders recursively.
+            found = folder.glob if name == "." else folder.rglob
+            for path in found(f".*{TEMP_SUFFIX}"):
+                if TEMP_NAME.match(path.name) and path.is_file():
+                    path.unlink(missing_ok=True)
+                    removed += 1
+        return removed

@@ -57,3 +57,25 @@ def test_truncated_and_missing_files_are_named(cache: Path, tmp_path: Path) -> N
         PreparedDataset(copy, "holdout", window=2)
     with pytest.raises(CacheError, match="no prepared cache"):
         PreparedDataset(tmp_path / "empty", "train", window=2)
+
+
+def test_pairs_carry_the_cached_body_weights(cache: Path, tmp_path: Path) -> None:
+    import shutil
+    from dataclasses import replace
+
+    from gnngarment.data.cache import read_garment, write_garment
+
+    dataset = PreparedDataset(cache, "train", window=2)
+    name = dataset.sequence_names[0]
+    garment = dataset.manifest["sequences"][name]["garment"]
+    record = read_garment(cache, garment)
+    np.testing.assert_array_equal(dataset.garment_of(name).pair.body_weights.numpy(),
+                                  record.body_weights)
+
+    copy = tmp_path / "copy"
+    shutil.copytree(cache, copy)
+    write_garment(copy, replace(record, body_weights=None))   # a cache from before them
+    assert PreparedDataset(copy, "train", window=2).garment_of(name).pair.body_weights is None
+    write_garment(copy, replace(record, body_weights=record.body_weights[:-1]))
+    with pytest.raises(CacheError, match="body_weights has shape"):
+        PreparedDataset(copy, "train", window=2).garment_of(name)

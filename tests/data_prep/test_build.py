@@ -27,6 +27,7 @@ from data_prep.build import (
 from data_prep.config import DataConfig
 from gnngarment.config import load_config
 from gnngarment.data import PreparedDataset
+from gnngarment.data.cache import read_garment, read_sequence
 from gnngarment.geometry.files import TEMP_SUFFIX
 from gnngarment.paths import REPOSITORY_ROOT
 
@@ -119,9 +120,65 @@ def test_build_killed_mid_way_resumes(tmp_path: Path) -> None:
         for name in dataset.sequence_names:
             batch = dataset.batch([(name, [0, dataset.frame_counts[name] - 1])])
             assert batch.target.isfinite().all()
+    # Every sequence starts from its garment's template, the drape on the still rest
+    # body: frame 0 is the template, and the motion's rest hold (all frames here) keeps
+    # the garment within a few mm of it (DESIGN.md: the template is the garment as worn).
+    moved = []
+    for name, info in manifest["sequences"].items():
+        garment = read_garment(tmp_path / "data", info["garment"])
+        positions = read_sequence(tmp_path / "data", name).positions
+        assert np.abs(positions[0] - garment.rest_pos).max() < 1e-5, name
+        drift = np.linalg.norm(positions - garment.rest_pos, axis=2).mean(axis=1).max()
+        assert drift < 0.015, (name, drift)  # tiny drapes stop at 30 frames: 3-9 mm
+        moved.append(np.linalg.norm(garment.rest_pos - garment.design_pos, axis=1).mean())
+    assert max(moved) > 0.002  # the templates are drapes, not the designs
     # The killed build's temporary files (if it died mid-write) were cleaned up.
     assert not [p for p in (tmp_path / "data").rglob(f"*{TEMP_SUFFIX}")]
 
     again = build_dataset(replace(config, workers=1), log=lambda _: None)
     assert again["simulated"] == 0  # built and failed sequences are both remembered
     assert again["manifest_hash"] == report["manifest_hash"]
+
+
+@pytest.mark.parametrize("config_name", ["demo", "benchmark"])
+def test_training_motions_move_every_joint(config_name: str) -> None:
+    """Real mocap moves the neck, collars, head, wrists and hands; training data that
+    never moves them cannot show that they leave trousers alone (issue 12 §2). Over the
+    training motions of the config, every joint turns at least 15° from the rest pose."""
+    from scipy.spatial.transform import Rotation
+
+    from gnngarment.body.procedural import make_motion
+    from gnngarment.body.skeleton import JOINT_NAMES
+
+    config = load_config(REPOSITORY_ROOT / "configs" / "data" / f"{config_name}.yaml",
+                         DataConfig)
+    motions = {p.motion for p in plan_dataset(config) if p.split == "train"}
+    largest = np.zeros(len(JOINT_NAMES))
+    for plan in motions:
+        motion = make_motion(plan.motion, duration=config.motion_seconds, fps=config.fps,
+                             seed=plan.seed)
+        angles = Rotation.from_rotvec(motion.rotations.reshape(-1, 3)).magnitude()
+        largest = np.maximum(largest, np.degrees(angles.reshape(len(motion), -1)).max(0))
+    still = {name: round(float(deg), 1) for name, deg in zip(JOINT_NAMES, largest, strict=True)
+             if deg < 15.0}
+    assert not still, f"joints that turn less than 15° in {config_name}'s training motions: {still}"
+
+
+@pytest.mark.parametrize(("override", "key"), [
+    ({"motions": ["walk", "moonwalk"]}, "motions"),
+    ({"garment_types": ["poncho"]}, "garment_types"),
+    ({"fps": -30.0}, "fps"),
+    ({"garment_vertices": [420, 300]}, "garment_vertices"),
+    ({"drape_frames": 0}, "drape_frames"),
+])
+def test_bad_config_values_name_the_file_and_key(tmp_path: Path, override: dict,
+                                                  key: str) -> None:
+    """An unknown name or a value out of range is a config error before any work (issue
+    15: `fps: -30` and unknown motions used to build with every sequence left out)."""
+    from gnngarment.config import ConfigError
+
+    values = OmegaConf.merge(OmegaConf.load(TINY), override)
+    path = tmp_path / "bad.yaml"
+    path.write_text(OmegaConf.to_yaml(values))
+    with pytest.raises(ConfigError, match=rf"{path}: key '{key}'"):
+        load_config(path, DataConfig)
