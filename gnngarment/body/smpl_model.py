@@ -56,6 +56,22 @@ def resolve_smpl_path(path: str | Path, gender: str = "neutral") -> Path:
     return path
 
 
+def _read_npz_without_code(path: Path) -> dict[str, np.ndarray]:
+    """Every array of an SMPL ``.npz``, refusing pickled objects: unpickling an untrusted
+    file can run code (a ``v_template`` holding a pickle ran ``os.system``), and SMPL's
+    arrays are all plain numbers and strings."""
+    try:
+        with np.load(path, allow_pickle=False) as archive:
+            return {name: archive[name] for name in archive.files}
+    except ValueError as error:
+        if "allow_pickle" in str(error):
+            raise SMPLModelError(
+                f"{path}: holds pickled Python objects, which are refused (loading them "
+                "could run code); convert it to plain arrays or pass the official .pkl "
+                "from a trusted source") from error
+        raise
+
+
 class SMPLBodyModel(BodyModel):
     """SMPL behind the :class:`BodyModel` interface; shape = betas ``(10,)``.
 
@@ -77,12 +93,14 @@ class SMPLBodyModel(BodyModel):
             # smplx prints a notice about 10-beta models on stdout; keep our output clean.
             with contextlib.redirect_stdout(io.StringIO()):
                 if self.path.suffix.lower() == ".npz":
-                    data = dict(np.load(self.path, allow_pickle=True))
+                    data = _read_npz_without_code(self.path)
                     self.smpl = smplx.SMPL(
                         str(self.path), data_struct=Struct(**data), gender=gender
                     )
                 else:
                     self.smpl = smplx.SMPL(str(self.path), gender=gender)
+        except SMPLModelError:
+            raise
         except Exception as error:
             raise SMPLModelError(f"{self.path}: not a readable SMPL model ({error})") from error
         if int(self.smpl.J_regressor.shape[0]) != NUM_JOINTS:

@@ -72,3 +72,26 @@ def test_missing_file_says_where_to_get_it(tmp_path):
     (tmp_path / "broken.pkl").write_bytes(b"not a pickle")
     with pytest.raises(SMPLModelError, match="broken.pkl"):
         SMPLBodyModel(tmp_path / "broken.pkl")
+
+
+class _Payload:
+    """Unpickling this creates a file: the proof that a pickle ran code."""
+
+    def __init__(self, marker: str) -> None:
+        self.marker = marker
+
+    def __reduce__(self):
+        return (open, (self.marker, "w"))
+
+
+def test_npz_with_a_pickled_object_is_refused_without_running_it(tmp_path):
+    """An SMPL .npz is untrusted input: an object array in it (a pickle) must not be
+    unpickled - issue 15's repro ran os.system before the error."""
+    marker = tmp_path / "payload_ran"
+    data = _synthetic_smpl()
+    data["v_template"] = np.array([_Payload(str(marker))], dtype=object)
+    path = tmp_path / "SMPL_NEUTRAL.npz"
+    np.savez(path, **data)
+    with pytest.raises(SMPLModelError, match="pickled Python objects"):
+        SMPLBodyModel(path)
+    assert not marker.exists()
