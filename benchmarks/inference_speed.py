@@ -73,8 +73,8 @@ COMPONENTS = ("pose_encoder", "velocity_encoder", "supervised_processor", "physi
 
 def make_pair(pos: np.ndarray, faces: np.ndarray, config: ModelConfig,
               seed: int = 0) -> GarmentBodyPair:
-    """A garment–body pair as ``tests/model/pairs.make_pair`` builds it (synthetic joints
-    and body distances: only shapes matter for speed)."""
+    """A garment–body pair as ``tests/model/pairs.make_pair`` builds it (synthetic joints,
+    body distances and body skinning weights: only shapes matter for speed)."""
     rng = np.random.default_rng(seed)
     joints = rng.normal(scale=0.3, size=(24, 3))
     prepared = prepare_garment(pos, faces, GarmentPreparationConfig(
@@ -85,7 +85,9 @@ def make_pair(pos: np.ndarray, faces: np.ndarray, config: ModelConfig,
         hierarchy=prepared.hierarchy,
         descriptor=torch.tensor(prepared.descriptor, dtype=torch.float32),
         body_distances=torch.tensor(rng.random((config.body_vertices, 24)),
-                                    dtype=torch.float32))
+                                    dtype=torch.float32),
+        body_weights=torch.tensor(rng.dirichlet(np.ones(24), size=len(pos)),
+                                  dtype=torch.float32))
 
 
 def frame_inputs(config: ModelConfig, frames: int, seed: int = 0
@@ -233,8 +235,12 @@ def initial_model(config: ModelConfig, args: argparse.Namespace
 
         model = load_model(path)
         ours, theirs = asdict(model.config), asdict(config)
-        ours.pop("attention", None)
-        theirs.pop("attention", None)
+        # Neither changes the timed network: the attention implementation is swapped
+        # below, and the weight prior is one add per skinning weight (the shipped model
+        # predates it and keeps ``none``).
+        for setting in ("attention", "weight_prior"):
+            ours.pop(setting, None)
+            theirs.pop(setting, None)
         if ours == theirs:
             return set_attention(model, config.attention).eval(), path.name
     torch.manual_seed(0)

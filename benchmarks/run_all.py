@@ -6,7 +6,9 @@
    and their ratio (``inference_speed.py``);
 3. training throughput per stage (``training_speed.py``, on the demo cache);
 4. ``gnngarment animate`` end to end (wall clock of the command, from process start to
-   the written OBJ/PC2/glb/GIF) on an unseen garment with the shipped model.
+   the written OBJ/PC2/glb/GIF) on an unseen garment with the shipped model;
+5. collision resolution per frame vs the network per frame, and their ratio
+   (``collision_resolution_speed.py``).
 
 Each step runs in its own process, one after the other (so they do not share the
 cores), and its output goes verbatim into the document under the command that made it.
@@ -143,6 +145,10 @@ def main() -> None:
             log.append(f"{frames} frames in {seconds:.1f} s including Python start-up, model "
                        f"and Anny loading, context preparation and every export "
                        f"({len(files)} files).\n")
+
+    code, _ = run_step("5. Collision resolution vs the network",
+                       [PYTHON, str(ROOT / "benchmarks/collision_resolution_speed.py")], log)
+    failures += ["collisions"] if code else []
 
     total = time.perf_counter() - started
     header = (

@@ -130,7 +130,9 @@ def prepare(
                        ] = None,
     from_cloth3d: Annotated[Path | None, typer.Option(
         "--from-cloth3d", help="Build the cache from a CLOTH3D folder instead.")] = None,
-    smpl_model: Annotated[Path | None, typer.Option(help="SMPL model file (CLOTH3D).")] = None,
+    smpl_model: Annotated[Path | None, typer.Option(
+        help="SMPL model file (CLOTH3D): .npz, or a .pkl from a trusted source only (a "
+             "pickle can run code).")] = None,
     output: Annotated[Path | None, typer.Option(help="Cache folder (overrides the config).")
                       ] = None,
 ) -> None:
@@ -225,7 +227,8 @@ def evaluate(
     spurious: Annotated[bool, typer.Option(help="Run the spurious-correlation test.")] = True,
 ) -> None:
     """Report E_verts, E_norm, collision rate, Hausdorff, STED and the spurious-correlation
-    test per garment type, for the model and the body-skinning baseline."""
+    test per garment type, for the model and the body-skinning baseline: of the output
+    after collision resolution as animate gives it, and raw_* of the output before it."""
     import json as json_module
 
     from gnngarment.data import CacheError, PreparedDataset
@@ -242,12 +245,32 @@ def evaluate(
         raise fail(str(error)) from None
     from tqdm import tqdm
 
+    from data_prep.posed_bodies import synthetic_body_meshes
+
     bar = tqdm(total=len(dataset), desc=f"evaluating {split}", unit="sequence")
     report = run_evaluation({"ours": model}, dataset, spurious=spurious,
-                            progress=lambda name: bar.update(1))
+                            progress=lambda name: bar.update(1),
+                            body_meshes=synthetic_body_meshes(data),
+                            collisions=_collision_settings())
     bar.close()
     console.print(report.to_markdown())
     write_report(report, markdown, json_path)
+
+
+def _collision_settings():
+    """``configs/collisions.yaml`` (or the dataclass defaults it mirrors, where the file is
+    absent), or a clear failure."""
+    from gnngarment.config import ConfigError, load_config
+    from gnngarment.geometry.body_collisions import CollisionSettings
+    from gnngarment.paths import default_config
+
+    path = default_config("collisions.yaml")
+    if not path.is_file():
+        return CollisionSettings()
+    try:
+        return load_config(path, CollisionSettings)
+    except ConfigError as error:
+        raise fail(str(error)) from None
 
 
 def _load_body_and_motion(body_shape: str, motion: str, fps: float, duration: float):
@@ -288,6 +311,9 @@ def animate(
     ignore_placement: Annotated[bool, typer.Option(
         help="Animate even if the garment does not sit on the body.")] = False,
     influences: Annotated[int, typer.Option(help="Joints per vertex in the glb skin.")] = 4,
+    resolve_collisions: Annotated[bool, typer.Option(
+        help="Move garment vertices out of the body (closer than epsilon, "
+             "configs/collisions.yaml), the rest garment and every frame.")] = True,
 ) -> None:
     """Animate a garment mesh on a body and motion; write OBJ/PC2/glb/GIF."""
     from tqdm import tqdm
@@ -332,7 +358,9 @@ def animate(
 
     try:
         animation = run_animation(model, pos, faces, body_inputs, frames, source=str(garment_mesh),
-                                  progress=advance)
+                                  progress=advance, resolve_collisions=resolve_collisions,
+                                  collisions=_collision_settings() if resolve_collisions
+                                  else None)
     except MeshError as error:
         raise fail(str(error)) from None
     bar.close()
@@ -352,6 +380,13 @@ def animate(
     for stage_bar in stages.values():
         stage_bar.close()
     seconds = animation.seconds
+    if animation.collisions is not None and animation.rest_collisions is not None:
+        stats, rest = animation.collisions, animation.rest_collisions
+        console.print(f"collisions: rest garment {int(rest.close[0])} vertices moved out of "
+                      f"the body; frames {int((stats.close > 0).sum())} of {len(stats.close)} "
+                      f"corrected, {stats.close.mean():.0f} vertices per frame on average "
+                      f"(largest push {1000 * stats.max_push.max():.1f} mm, "
+                      f"{seconds['collisions']:.2f} s)")
     console.print(f"[green]animated[/] {len(motion_value)} frames "
                   f"(context {seconds['context']:.2f} s, frames {seconds['frames']:.2f} s); wrote:")
     for key, path in paths.items():
@@ -381,8 +416,16 @@ def benchmark_accuracy(
         settings = load_training_config(config)
     except (ConfigError, ValueError) as error:
         raise fail(str(error)) from None
+    from data_prep.posed_bodies import synthetic_body_meshes
+    from gnngarment.data import CacheError
+
+    try:
+        body_meshes = synthetic_body_meshes(settings.data)
+    except CacheError as error:
+        raise fail(str(error)) from None
     result = run_benchmark(settings, output, variant, split,
-                           command="gnngarment " + " ".join(sys.argv[1:]))
+                           command="gnngarment " + " ".join(sys.argv[1:]),
+                           body_meshes=body_meshes)
     console.print(f"[green]wrote[/] {output}: {len(result['rows'])} rows")
 
 

@@ -71,3 +71,21 @@ def interleave(pos: np.ndarray, faces: np.ndarray, seed: int) -> tuple[np.ndarra
     inverse = np.empty_like(permutation)
     inverse[permutation] = np.arange(len(pos))
     return pos[permutation], inverse[faces]
+
+
+def closed_box(half: np.ndarray, subdivisions: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """A closed axis-aligned box centred at the origin (outward winding), its faces
+    subdivided so triangles are small (like a body mesh); half extents ``(3,)``."""
+    import trimesh
+
+    mesh = trimesh.creation.box(extents=2 * np.asarray(half, dtype=np.float64))
+    for _ in range(subdivisions):
+        mesh = mesh.subdivide()
+    return np.asarray(mesh.vertices), np.asarray(mesh.faces)
+
+
+def box_signed_distance(points: np.ndarray, half: np.ndarray) -> np.ndarray:
+    """Exact signed distance ``(N,)`` of ``points (N, 3)`` to the box of
+    :func:`closed_box` (negative inside)."""
+    q = np.abs(points) - np.asarray(half)
+    return np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)

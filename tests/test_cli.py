@@ -64,3 +64,27 @@ def test_bad_input_exits_2_with_a_message_and_no_traceback(tmp_path: Path) -> No
         assert result.exit_code == 2, result.output
         assert message in " ".join(result.output.split())
         assert "Traceback" not in result.output
+
+
+def test_evaluate_reports_resolved_and_raw_metrics(tmp_path: Path) -> None:
+    import torch
+
+    from gnngarment.model import GarmentDeformer
+    from gnngarment.training.checkpoint import model_payload, save_checkpoint
+    from tests.model.pairs import tiny_config
+    from tests.synthetic_cache import build_synthetic_cache
+
+    cache = build_synthetic_cache(tmp_path / "cache", frames=4)
+    torch.manual_seed(0)
+    checkpoint = tmp_path / "model.pt"
+    save_checkpoint(checkpoint, model_payload(GarmentDeformer(tiny_config())))
+    result = runner.invoke(app, ["evaluate", "--checkpoint", str(checkpoint), "--data",
+                                 str(cache), "--no-spurious", "--json",
+                                 str(tmp_path / "report.json")])
+    assert result.exit_code == 0, result.output
+    report = json.loads((tmp_path / "report.json").read_text())
+    values = report["results"]["ours"]["all"]
+    assert {"e_verts_mm", "raw_e_verts_mm", "collision_pct", "raw_collision_pct"} <= set(values)
+    # This cache was not built from a synthetic config: no body meshes, nothing resolved.
+    assert report["unresolved"] and values["e_verts_mm"] == values["raw_e_verts_mm"]
+    assert "Not resolved" in result.output

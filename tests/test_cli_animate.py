@@ -36,7 +36,14 @@ def files(tmp_path_factory: pytest.TempPathFactory, anny_body) -> dict[str, Path
     trimesh.Trimesh(pos, faces, process=False).export(garment)
     centimetres = folder / "skirt_cm.obj"
     trimesh.Trimesh(pos * 100, faces, process=False).export(centimetres)
-    return {"checkpoint": checkpoint, "garment": garment, "cm": centimetres, "folder": folder}
+    # A skirt whose waist is narrower than the body's: it cuts into the hips.
+    tight, tight_faces = flared_skirt(400, waist_radius=0.12, hem_radius=0.22, length=0.35,
+                                      waist_height=pelvis[2] + 0.05, seed=1)
+    tight[:, :2] += pelvis[:2]
+    tight_path = folder / "tight.obj"
+    trimesh.Trimesh(tight, tight_faces, process=False).export(tight_path)
+    return {"checkpoint": checkpoint, "garment": garment, "cm": centimetres, "folder": folder,
+            "tight": tight_path}
 
 
 def test_animate_writes_exports_in_the_input_vertex_order(files) -> None:
@@ -80,3 +87,31 @@ def test_bad_inputs_exit_2(files, tmp_path: Path) -> None:
         result = runner.invoke(app, arguments)
         assert result.exit_code == 2, (arguments, result.output)
         assert message in " ".join(result.output.split())
+
+
+def test_collisions_are_resolved_unless_turned_off(files, anny_body) -> None:
+    from gnngarment.geometry.signed_distance import refit_mesh, signed_distance_warp, warp_mesh
+
+    pos, _ = load_mesh(files["tight"])
+    depth = {}
+    for flag in ("--resolve-collisions", "--no-resolve-collisions"):
+        out = files["folder"] / flag.strip("-")
+        result = runner.invoke(app, ["animate", str(files["tight"]), "--checkpoint",
+                                     str(files["checkpoint"]), "--out", str(out),
+                                     "--duration", "0.2", "--format", "pc2", flag,
+                                     "--ignore-placement"])
+        assert result.exit_code == 0, result.output
+        assert ("collisions:" in result.output) == (flag == "--resolve-collisions")
+        garment, body = read_point_cache(out / "tight.pc2"), read_point_cache(
+            out / "tight_body.pc2")
+        mesh = warp_mesh(body[0], anny_body.faces)
+        depth[flag] = []
+        for t in range(len(garment)):
+            refit_mesh(mesh, body[t])
+            depth[flag].append(signed_distance_warp(mesh, garment[t]).min())
+        rest, _ = load_mesh(out / "tight_rest.obj")
+        moved = np.abs(rest - pos).max()
+        assert (moved > 1e-3) == (flag == "--resolve-collisions")
+    assert min(depth["--resolve-collisions"]) >= 0.002 * 0.999
+    assert min(depth["--no-resolve-collisions"]) < 0
+

@@ -6,6 +6,7 @@ from pathlib import Path
 import pytest
 
 from gnngarment.config import ConfigError, load_config
+from gnngarment.geometry.body_collisions import CollisionSettings
 from gnngarment.geometry.prepare import GarmentPreparationConfig
 from gnngarment.paths import default_config
 
@@ -47,3 +48,8 @@ def test_missing_file_and_section(tmp_path: Path) -> None:
 def test_shipped_garment_yaml_equals_the_dataclass_defaults() -> None:
     loaded = load_config(default_config("garment.yaml"), GarmentPreparationConfig)
     assert asdict(loaded) == asdict(GarmentPreparationConfig())
+
+
+def test_shipped_collisions_yaml_equals_the_dataclass_defaults() -> None:
+    loaded = load_config(default_config("collisions.yaml"), CollisionSettings)
+    assert asdict(loaded) == asdict(CollisionSettings())

@@ -156,7 +156,8 @@ def attribute_command(
         "--shape", help="Anny preset or .json/.yaml phenotype file; SMPL betas file.")] = None,
     body_model: Annotated[str, typer.Option("--body-model", help="anny or smpl.")] = "anny",
     smpl_path: Annotated[str, typer.Option(
-        "--smpl-path", help="SMPL .pkl/.npz (with --body-model smpl).")] = "",
+        "--smpl-path", help="SMPL .npz, or a .pkl from a trusted source only (a pickle "
+                              "can run code); with --body-model smpl.")] = "",
     fps: Annotated[float, typer.Option("--fps", help="Motion frame rate.")] = 30.0,
     duration: Annotated[float, typer.Option(
         "--duration", help="Seconds (procedural motions).")] = 4.0,

@@ -49,7 +49,8 @@ def body_command(
     ] = None,
     model: Annotated[str, typer.Option("--model", help="Body model: anny or smpl.")] = "anny",
     smpl_path: Annotated[
-        str, typer.Option("--smpl-path", help="SMPL .pkl/.npz (with --model smpl).")
+        str, typer.Option("--smpl-path", help="SMPL .npz, or a .pkl from a trusted "
+                          "source only (a pickle can run code); with --model smpl.")
     ] = "",
     fps: Annotated[float, typer.Option("--fps", help="Output frame rate.")] = 30.0,
     duration: Annotated[

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from gnngarment.data.dataset import PreparedDataset
-from gnngarment.evaluation.evaluate import METRICS, evaluate
+from gnngarment.evaluation.evaluate import METRICS, BodyMeshes, evaluate
 from gnngarment.geometry.files import atomic_write_bytes
 from gnngarment.training.checkpoint import load_model
 from gnngarment.training.config import TrainingConfig
@@ -26,9 +26,12 @@ VARIANTS = {
 
 
 def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | None = None,
-                  split: str = "test", command: str = "") -> dict[str, Any]:
+                  split: str = "test", command: str = "",
+                  body_meshes: BodyMeshes | None = None) -> dict[str, Any]:
     """Train every variant with ``config`` (levels/pooling changed only), evaluate each
-    before and after the physics stage, and write ``output`` (Markdown)."""
+    before and after the physics stage, and write ``output`` (Markdown). ``body_meshes``
+    gives the posed body meshes the evaluation resolves collisions against
+    (:func:`~gnngarment.evaluation.evaluate.evaluate`)."""
     names = variants or list(VARIANTS)
     # method → {garment type or "all" → metrics}, body skinning first once evaluated.
     results: dict[str, dict[str, dict[str, float]]] = {}
@@ -51,12 +54,13 @@ def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | No
             path = run_folder / checkpoint
             if not path.is_file():
                 continue
-            report = evaluate({name: load_model(path)}, test, body_skinning=lbs is None)
+            report = evaluate({name: load_model(path)}, test, body_skinning=lbs is None,
+                              body_meshes=body_meshes)
             results[f"{name}, {label}"] = report.results[name]
-            if lbs is None and "body skinning (LBS)" in report.results:
-                lbs = report.results["body skinning (LBS)"]
+            if lbs is None and "body skinning (draped template)" in report.results:
+                lbs = report.results["body skinning (draped template)"]
     if lbs is not None:
-        results = {"body skinning (LBS)": lbs, **results}
+        results = {"body skinning (draped template)": lbs, **results}
     rows = {name: values["all"] for name, values in results.items()}
     lines = ["# Accuracy on held-out garments, bodies and motions", "",
              f"Split `{split}` of `{config.data}`; every learned variant trained with the same "

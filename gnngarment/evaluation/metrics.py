@@ -1,8 +1,9 @@
 """Per-frame error metrics of predicted garments (pure numpy).
 
 Shapes: ``pred``/``target`` are ``(T, N, 3)`` garment vertices in metres, ``faces (F, 3)``,
-``edges (E, 2)``. Every function returns one value per frame ``(T,)`` so callers can
-average over frames, sequences and garment types as they need.
+``edges (E, 2)``. Every error function returns one value per frame ``(T,)`` so callers
+can average over frames, sequences and garment types as they need; the skinning-weight
+diagnostic :func:`far_joint_weight` summarises a whole sequence.
 """
 
 from __future__ import annotations
@@ -80,3 +81,40 @@ def collision_rate(pred: np.ndarray, body_points: np.ndarray, body_normals: np.n
         offset = ((pred[t] - body_points[t][nearest]) * body_normals[t][nearest]).sum(-1)
         rates[t] = 100.0 * (offset < 0).mean()
     return rates
+
+
+def far_joint_weight(weights: np.ndarray, rest_pos: np.ndarray, body_rest_vertices: np.ndarray,
+                     body_skinning_weights: np.ndarray, radius: float = 0.20
+                     ) -> dict[str, float]:
+    """Skinning weight a garment puts on joints whose body part is far away: for each
+    vertex, the summed weight on the joints whose body region lies more than ``radius``
+    from the vertex's rest position. A joint's region is the body vertices whose
+    dominant skinning joint it is; its distance is that of the region's nearest vertex.
+    A joint that dominates no body vertex has no region and counts as far. Such weight
+    makes the vertex follow a distant limb (a hem dragged along by a wrist).
+
+    Shapes:
+        weights ``(T, N, 24)`` or ``(N, 24)`` garment skinning weights, rest_pos
+        ``(N, 3)`` (metres), body_rest_vertices ``(N_b, 3)`` (same rest frame),
+        body_skinning_weights ``(N_b, 24)``; ``radius`` in metres.
+
+    Returns:
+        ``{"max": ..., "mean": ...}``: the largest and the mean far weight over vertices
+        and frames, as fractions of each vertex's unit weight (0 = none, 1 = all).
+    """
+    from scipy.spatial import cKDTree
+
+    weights = np.asarray(weights)
+    if weights.ndim == 2:
+        weights = weights[None]
+    joints = body_skinning_weights.shape[1]
+    if weights.ndim != 3 or weights.shape[1:] != (len(rest_pos), joints):
+        raise ValueError(f"weights must be (T, {len(rest_pos)}, {joints}) or "
+                         f"({len(rest_pos)}, {joints}), got {weights.shape}")
+    dominant = np.argmax(body_skinning_weights, axis=1)
+    distance = np.full((len(rest_pos), joints), np.inf)
+    for joint in np.unique(dominant):
+        region = body_rest_vertices[dominant == joint]
+        distance[:, joint] = cKDTree(region).query(rest_pos)[0]
+    far = (weights * (distance > radius)[None]).sum(-1)                # (T, N)
+    return {"max": float(far.max()), "mean": float(far.mean())}

@@ -1,8 +1,14 @@
-"""Garment mesh geometry: pure numpy/scipy, imports nothing else of gnngarment.
+"""Garment mesh geometry: pure numpy/scipy (Warp, imported lazily, for queries against
+the body mesh), imports nothing else of gnngarment.
 
 Public API (arrays in, arrays out; ``pos (N, 3)``, ``faces (F, 3)``, ``edge_index (2, E)``):
 """
 
+from gnngarment.geometry.body_collisions import (
+    CollisionSettings,
+    CollisionStats,
+    resolve_collisions,
+)
 from gnngarment.geometry.eccentricity import graph_centres, hop_distance
 from gnngarment.geometry.errors import MeshError
 from gnngarment.geometry.geodesics import farthest_point_sampling, geodesic_distances
@@ -24,11 +30,12 @@ from gnngarment.geometry.validation import (
 )
 
 __all__ = [
-    "GarmentPreparationConfig", "MeshError", "MeshReport", "PoolHierarchy", "PoolLevel",
-    "PooledGraph", "PreparedGarment", "adjacency_matrix", "check_mesh", "connected_components",
-    "edge_index_from_faces", "face_normals", "farthest_point_sampling", "geodesic_distances",
-    "graph_centres", "hop_distance", "joint_distances", "load_mesh", "mesh_scale",
-    "nystrom_descriptor", "pool", "pool_hierarchy", "prepare_garment",
-    "remove_unreferenced_vertices", "surface_area", "unpooling_matrix", "validate_mesh",
+    "CollisionSettings", "CollisionStats", "GarmentPreparationConfig", "MeshError",
+    "MeshReport", "PoolHierarchy", "PoolLevel", "PooledGraph", "PreparedGarment",
+    "adjacency_matrix", "check_mesh", "connected_components", "edge_index_from_faces",
+    "face_normals", "farthest_point_sampling", "geodesic_distances", "graph_centres",
+    "hop_distance", "joint_distances", "load_mesh", "mesh_scale", "nystrom_descriptor",
+    "pool", "pool_hierarchy", "prepare_garment", "remove_unreferenced_vertices",
+    "resolve_collisions", "surface_area", "unpooling_matrix", "validate_mesh",
     "vertex_areas", "vertex_normals",
 ]

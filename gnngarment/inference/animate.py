@@ -12,6 +12,8 @@ from gnngarment.data.body_inputs import BodyMotionInputs, BodyShapeInputs
 from gnngarment.data.dataset import window_indices
 from gnngarment.data.pair import GarmentBodyPair
 from gnngarment.data.vertex_features import garment_vertex_features
+from gnngarment.geometry import body_collisions
+from gnngarment.geometry.body_collisions import CollisionSettings, CollisionStats
 from gnngarment.geometry.prepare import GarmentPreparationConfig, PreparedGarment, prepare_garment
 from gnngarment.model.deformer import GarmentDeformer
 
@@ -21,14 +23,22 @@ class Animation:
     """A garment animated on a body.
 
     Attributes:
-        rest_pos: ``(N, 3)`` garment rest vertices (input order), faces ``(F, 3)``.
+        rest_pos: ``(N, 3)`` garment rest vertices (input order) as animated (moved out
+            of the rest body when collisions are resolved), faces ``(F, 3)``.
         posed: ``(T, N, 3)`` animated garment (world, metres).
         weights: ``(T, N, 24)`` predicted skinning weights.
         blend_shapes: ``(T, N, 3)`` predicted blend shapes (rest frame, metres).
         joint_transforms: ``(T, 24, 4, 4)``; rest_joints ``(24, 3)``.
         body_vertices: ``(T, N_b, 3)`` posed body, body_faces ``(F_b, 3)``.
         fps: frames per second.
-        seconds: wall-clock of the context (per pair) and of all frames.
+        seconds: wall-clock of the context (per pair), of all frames and of the
+            collision resolution (``collisions``).
+        raw_posed: ``(T, N, 3)`` the network's output before collision resolution
+            (``posed`` itself when resolution was off); raw_rest_pos ``(N, 3)`` the rest
+            garment as given, before its penetration of the rest body was removed.
+            ``None`` only in an Animation built by hand.
+        collisions, rest_collisions: what the resolution did per frame and to the rest
+            garment (:class:`CollisionStats`), ``None`` when it was off.
     """
 
     rest_pos: np.ndarray
@@ -42,6 +52,10 @@ class Animation:
     body_faces: np.ndarray
     fps: float
     seconds: dict[str, float]
+    raw_posed: np.ndarray | None = None
+    raw_rest_pos: np.ndarray | None = None
+    collisions: CollisionStats | None = None
+    rest_collisions: CollisionStats | None = None
 
 
 def garment_pair(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,
@@ -49,10 +63,26 @@ def garment_pair(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,
                  source: str = "<garment>") -> GarmentBodyPair:
     """The model input of a garment (rest positions on the body's rest frame) on a body.
 
+    For a model with the ``body`` weight prior, the body's skinning weights are
+    transferred to the garment (:func:`transfer_body_weights`, as the cache builders do).
+
     Raises:
         MeshError: the garment mesh is unusable (names ``source``).
+        ValueError: the model has the ``body`` weight prior and ``body`` has no skinning
+            weights.
     """
     config = model.config
+    body_weights = None
+    if config.weight_prior == "body":
+        # Imported here: the evaluation package imports much of the library.
+        from gnngarment.evaluation.baselines import transfer_body_weights
+
+        if body.skinning_weights is None:
+            raise ValueError(f"{source}: the model's weight_prior 'body' needs the body's "
+                             "skinning weights (BodyShapeInputs.skinning_weights is None; "
+                             "the body model does not expose them)")
+        body_weights = torch.from_numpy(transfer_body_weights(
+            np.asarray(pos, dtype=np.float64), body.rest_vertices, body.skinning_weights))
     if prepared is None:
         prepared = prepare_garment(pos, faces, GarmentPreparationConfig(
             levels=config.levels, landmarks=config.landmarks), source=source)
@@ -61,14 +91,22 @@ def garment_pair(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,
         rest_pos=torch.tensor(pos, dtype=torch.float32),
         features=torch.from_numpy(features), hierarchy=prepared.hierarchy,
         descriptor=torch.tensor(prepared.descriptor, dtype=torch.float32),
-        body_distances=torch.from_numpy(body.distances))
+        body_distances=torch.from_numpy(body.distances), body_weights=body_weights)
 
 
 @torch.inference_mode()
 def animate(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray, body: BodyShapeInputs,
             frames: BodyMotionInputs, chunk: int = 16, source: str = "<garment>",
-            progress: Callable[[int, int], None] | None = None) -> Animation:
+            progress: Callable[[int, int], None] | None = None,
+            resolve_collisions: bool = True,
+            collisions: CollisionSettings | None = None) -> Animation:
     """Predict the garment for every frame of a posed body.
+
+    With ``resolve_collisions`` (the default) the output is penetration-free: the rest
+    garment's penetration of the rest body is removed before the network sees it, and
+    every predicted frame's vertices inside the posed body or closer than ``ε`` are
+    moved out (:func:`~gnngarment.geometry.body_collisions.resolve_collisions`); the
+    network's own output stays in ``Animation.raw_posed``.
 
     Args:
         model: a trained deformer (eval mode is set here).
@@ -78,12 +116,27 @@ def animate(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray, body: Bo
         frames: the posed body's per-frame inputs (:func:`body_motion_inputs`).
         chunk: frames per forward pass.
         progress: called with (frames done, total) after each chunk.
+        resolve_collisions: remove body penetrations (rest garment and every frame).
+        collisions: ``ε`` and smoothing; default :class:`CollisionSettings`.
+
+    Raises:
+        MeshError: the garment mesh is unusable (names ``source``).
     """
     import time
 
+    from gnngarment.geometry.validation import validate_mesh
+
     model.eval()
+    settings = collisions or CollisionSettings()
+    rest, rest_stats, collision_seconds = np.asarray(pos), None, 0.0
+    if resolve_collisions:
+        validate_mesh(rest, faces, source)
+        started = time.perf_counter()
+        rest, rest_stats = body_collisions.resolve_collisions(
+            rest, faces, body.rest_vertices, body.faces, settings)
+        collision_seconds = time.perf_counter() - started
     started = time.perf_counter()
-    pair = garment_pair(model, pos, faces, body, source=source)
+    pair = garment_pair(model, rest, faces, body, source=source)
     context = model.prepare([pair])
     context_seconds = time.perf_counter() - started
 
@@ -105,10 +158,20 @@ def animate(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray, body: Bo
         blend.append(out.blend_shapes.view(count, -1, 3))
         if progress is not None:
             progress(start + count, total)
+    frames_seconds = time.perf_counter() - started
+    raw_posed = torch.cat(posed).numpy()
+    resolved, stats = raw_posed, None
+    if resolve_collisions:
+        started = time.perf_counter()
+        resolved, stats = body_collisions.resolve_collisions(
+            raw_posed, faces, frames.vertices, body.faces, settings)
+        collision_seconds += time.perf_counter() - started
     return Animation(
-        rest_pos=np.asarray(pos, dtype=np.float32), faces=np.asarray(faces, dtype=np.int64),
-        posed=torch.cat(posed).numpy(), weights=torch.cat(weights).numpy(),
+        rest_pos=np.asarray(rest, dtype=np.float32), faces=np.asarray(faces, dtype=np.int64),
+        posed=resolved, weights=torch.cat(weights).numpy(),
         blend_shapes=torch.cat(blend).numpy(), joint_transforms=frames.joint_transforms,
         rest_joints=body.joints, body_vertices=frames.vertices, body_faces=body.faces,
-        fps=frames.fps, seconds={"context": context_seconds,
-                                 "frames": time.perf_counter() - started})
+        fps=frames.fps, seconds={"context": context_seconds, "frames": frames_seconds,
+                                 "collisions": collision_seconds},
+        raw_posed=raw_posed, raw_rest_pos=np.asarray(pos, dtype=np.float32), collisions=stats,
+        rest_collisions=rest_stats)

@@ -15,7 +15,7 @@ def test_benchmark_trains_variants_and_writes_the_table(tmp_path: Path) -> None:
                             stages=StageConfig(max_epochs=[1, 1, 0]))
     result = run_benchmark(config, tmp_path / "results.md",
                            ["ours (2 levels)", "single level"], command="test")
-    assert set(result["rows"]) == {"body skinning (LBS)", "ours (2 levels), supervised",
+    assert set(result["rows"]) == {"body skinning (draped template)", "ours (2 levels), supervised",
                                    "ours (2 levels), + physics", "single level, supervised",
                                    "single level, + physics"}
     table = (tmp_path / "results.md").read_text()

@@ -72,3 +72,25 @@ def test_perturbation_moves_only_the_subtree() -> None:
     _, same_transforms = perturb_joint(features, transforms, rest_joints, "L_wrist",
                                                    np.zeros(3))
     np.testing.assert_allclose(same_transforms, transforms, atol=1e-6)
+
+
+def test_far_joint_weight_counts_weight_on_distant_body_regions() -> None:
+    # Body: joint 0 dominates a cluster at x = 0, joint 1 one at x = 1 (each vertex
+    # also carries a little weight on joint 2, which dominates nothing).
+    body = np.array([[0.0, 0, 0], [0.0, 0.1, 0], [1.0, 0, 0], [1.0, 0.1, 0]])
+    body_weights = np.zeros((4, 24))
+    body_weights[:2, 0], body_weights[2:, 1], body_weights[:, 2] = 0.9, 0.9, 0.1
+    rest = np.array([[0.05, 0, 0], [0.95, 0, 0]])   # garment vertices near each cluster
+    weights = np.zeros((2, 2, 24))
+    weights[0, 0, [0, 1]] = 0.7, 0.3                 # 0.3 on the far joint 1
+    weights[0, 1, 1] = 1.0                           # all on its own region
+    weights[1, 0, 0] = 1.0
+    weights[1, 1, [1, 2]] = 0.4, 0.6                 # 0.6 on joint 2: no region, far
+    result = metrics.far_joint_weight(weights, rest, body, body_weights, radius=0.2)
+    assert result["max"] == pytest.approx(0.6)
+    assert result["mean"] == pytest.approx((0.3 + 0 + 0 + 0.6) / 4)
+    # A radius wider than the body: only the region-less joint 2 is still far.
+    wide = metrics.far_joint_weight(weights[0], rest, body, body_weights, radius=2.0)
+    assert wide == {"max": 0.0, "mean": 0.0}
+    with pytest.raises(ValueError, match="weights must be"):
+        metrics.far_joint_weight(weights[:, :1], rest, body, body_weights)

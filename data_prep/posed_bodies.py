@@ -1,0 +1,78 @@
+"""The posed body meshes of a synthetic cache's sequences, for collision resolution in
+``gnngarment evaluate``.
+
+The cache stores per frame only body *samples* (``body_points``); resolving garment
+penetrations needs the whole body mesh. A synthetic build is a pure function of its
+config (stored in the manifest), so each sequence's body is posed again here exactly as
+:func:`data_prep.build.simulate_sequence` posed it, and checked against the stored
+samples: a cache built by another version of the planner, the motions or the body
+model gives no mesh (with a warning) rather than a wrong one.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+#: Largest difference [m] between a re-posed body vertex coordinate and its stored
+#: sample, beyond float16 storage rounding (half a unit in the last place, 2^-11 relative).
+MATCH_TOLERANCE = 0.001
+
+BodyMesh = tuple[np.ndarray, np.ndarray]
+
+
+def synthetic_body_meshes(root: str | Path) -> Callable[[str], BodyMesh | None]:
+    """``sequence name → (vertices (T, N_b, 3), faces (F_b, 3))`` of the posed body of a
+    synthetic cache (``None`` for a sequence it cannot reproduce, and for every sequence
+    of a cache that was not built from a synthetic config, e.g. CLOTH3D's).
+
+    Anny is constructed on the first call (about a second with its cache in place).
+    """
+    from data_prep.build import plan_dataset
+    from data_prep.config import DataConfig
+    from gnngarment.config import ConfigError, merge_config
+    from gnngarment.data.cache import read_manifest, read_sequence
+
+    root = Path(root)
+    manifest = read_manifest(root)
+    if "config" not in manifest:
+        return lambda name: None
+    try:
+        config = merge_config(DataConfig, manifest["config"], source=f"{root}/manifest.json")
+        plans = {plan.name: plan for plan in plan_dataset(config)}
+    except (ConfigError, ValueError, KeyError) as error:
+        warnings.warn(f"{root}: cannot re-plan the build ({error}); collisions are not "
+                      "resolved", stacklevel=2)
+        return lambda name: None
+    state: dict = {}
+
+    def body_mesh(name: str) -> BodyMesh | None:
+        import torch
+
+        from gnngarment.body.anny_model import AnnyBodyModel, AnnyShape
+        from gnngarment.body.procedural import make_motion
+
+        plan = plans.get(name)
+        if plan is None:
+            return None
+        if "model" not in state:
+            state["model"] = AnnyBodyModel()
+        model = state["model"]
+        motion = make_motion(plan.motion.motion, duration=config.motion_seconds,
+                             fps=config.fps, seed=plan.motion.seed)
+        with torch.no_grad():
+            vertices = model.pose(motion, AnnyShape(**plan.body.shape)).vertices.numpy()
+        stored = read_sequence(root, name).body_points
+        samples = model.feature_vertex_indices(config.collision_points)
+        if (stored.shape != (len(vertices), len(samples), 3)
+                or (np.abs(vertices[:, samples] - stored)
+                    > MATCH_TOLERANCE + np.abs(stored) * 2.0**-11).any()):
+            warnings.warn(f"{root}: {name}: the re-posed body does not match the cached "
+                          "body samples; its collisions are not resolved", stacklevel=2)
+            return None
+        return vertices, model.faces
+
+    return body_mesh

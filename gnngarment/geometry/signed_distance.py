@@ -1,0 +1,233 @@
+"""Signed distance of points to a closed triangle mesh (inside/outside of the body).
+
+Small Warp kernels over Warp's mesh BVH on the CPU (Warp is imported lazily, its kernels
+compiled on first use and cached on disk):
+
+* :func:`signed_distance_warp` — closest-point query plus ray-crossing parity for the
+  sign (``wp.mesh_query_point_sign_parity``), correct for closed meshes like the posed
+  body. On 3,000 points around the walking Anny body it agreed with an exact winding
+  number on every point; the closest-face-normal sign (``mesh_query_point_sign_normal``,
+  2× faster) got two points between the toes wrong (docs/simulation.md). The reference
+  simulator's inside test uses it every frame.
+* :func:`surface_offsets` — per point the signed distance, the closest surface point and
+  the outward direction to it, searched within a given distance (points farther away
+  cost almost nothing), signed by the angle-weighted pseudo-normal unless the caller
+  already knows the point is inside; :func:`inside_by_parity` — one ray's crossing
+  parity. :mod:`~gnngarment.geometry.body_collisions` combines the two.
+
+A mesh that moves (the posed body, frame after frame) is built once with
+:func:`warp_mesh` and refit with :func:`refit_mesh`.
+"""
+
+from __future__ import annotations
+
+import functools
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+#: Closest-point search radius [m]; points farther from the body count as outside
+#: (no garment vertex lies more than this deep inside a human body).
+SEARCH_RADIUS = 1.0
+
+
+def import_warp() -> ModuleType:
+    """``warp``, initialised quietly on the CPU.
+
+    Raises:
+        ImportError: warp-lang is not installed (with the pip command that fixes it).
+    """
+    try:
+        import warp as wp
+    except ImportError as error:  # pragma: no cover - depends on the environment
+        raise ImportError(
+            "mesh distance queries need NVIDIA Warp: pip install 'warp-lang>=1.19'"
+        ) from error
+    # Warp prints its banner, a "no CUDA driver" warning and every module load otherwise.
+    # (Warp 1.19 reads log_level; older versions read quiet.)
+    wp.config.quiet = True
+    if hasattr(wp, "LOG_ERROR"):
+        wp.config.log_level = wp.LOG_ERROR
+    wp.init()
+    return wp
+
+
+def warp_mesh(vertices: np.ndarray, faces: np.ndarray) -> Any:
+    """A ``warp.Mesh`` on the CPU (refittable: its points can be rewritten).
+
+    Shapes: vertices ``(V, 3)`` [m]; faces ``(F, 3)`` int, outward winding.
+    """
+    wp = import_warp()
+    return wp.Mesh(points=wp.array(np.ascontiguousarray(vertices, dtype=np.float32),
+                                   dtype=wp.vec3, device="cpu"),
+                   indices=wp.array(np.ascontiguousarray(faces, dtype=np.int32).ravel(),
+                                    dtype=wp.int32, device="cpu"))
+
+
+def refit_mesh(mesh: Any, vertices: np.ndarray) -> None:
+    """Move ``mesh``'s vertices to ``vertices`` ``(V, 3)`` (same count) and refit its BVH."""
+    vertices = np.ascontiguousarray(vertices, dtype=np.float32)
+    if vertices.shape != (mesh.points.shape[0], 3):
+        raise ValueError(f"vertices must be ({mesh.points.shape[0]}, 3), got {vertices.shape}")
+    mesh.points.numpy()[...] = vertices  # a CPU warp array shares its memory with numpy
+    mesh.refit()
+
+
+@functools.lru_cache(maxsize=1)
+def _kernels() -> dict[str, Any]:
+    """The Warp kernels, defined on first use (Warp is imported lazily) and all at once:
+    Warp compiles a Python module's kernels together, so one set means one build."""
+    wp = import_warp()
+
+    @wp.kernel
+    def signed_distance(mesh: wp.uint64, points: wp.array(dtype=wp.vec3),
+                        max_dist: float, out: wp.array(dtype=float)):
+        tid = wp.tid()
+        query = wp.mesh_query_point_sign_parity(mesh, points[tid], max_dist)
+        if query.result:
+            closest = wp.mesh_eval_position(mesh, query.face, query.u, query.v)
+            out[tid] = query.sign * wp.length(points[tid] - closest)
+        else:
+            out[tid] = max_dist
+
+    @wp.func
+    def report(mesh: wp.uint64, tid: int, point: wp.vec3, face: int, u: float, v: float,
+               sign: float, distance: wp.array(dtype=float), closest: wp.array(dtype=wp.vec3),
+               direction: wp.array(dtype=wp.vec3)):
+        surface = wp.mesh_eval_position(mesh, face, u, v)
+        offset = point - surface
+        length = wp.length(offset)
+        # Outward unit direction: from the closest surface point towards a point
+        # outside, away from a point inside; on the surface itself, the face normal.
+        outward = wp.mesh_eval_face_normal(mesh, face)
+        if length > 1.0e-7:
+            outward = offset * (sign / length)
+        distance[tid] = sign * length
+        closest[tid] = surface
+        direction[tid] = outward
+
+    @wp.kernel
+    def offsets(mesh: wp.uint64, points: wp.array(dtype=wp.vec3), max_dist: float,
+                inside: wp.array(dtype=wp.int8), distance: wp.array(dtype=float),
+                closest: wp.array(dtype=wp.vec3), direction: wp.array(dtype=wp.vec3)):
+        tid = wp.tid()
+        point = points[tid]
+        if inside[tid] != wp.int8(0):  # known to be inside: any depth, sign known
+            known = wp.mesh_query_point_no_sign(mesh, point, max_dist)
+            if known.result:
+                report(mesh, tid, point, known.face, known.u, known.v, -1.0, distance,
+                       closest, direction)
+                return
+        else:
+            query = wp.mesh_query_point_sign_normal(mesh, point, max_dist)
+            if query.result:
+                report(mesh, tid, point, query.face, query.u, query.v, query.sign, distance,
+                       closest, direction)
+                return
+        distance[tid] = wp.inf
+        closest[tid] = point
+        direction[tid] = wp.vec3(0.0, 0.0, 0.0)
+
+    @wp.kernel
+    def parity(mesh: wp.uint64, points: wp.array(dtype=wp.vec3), inside: wp.array(dtype=wp.int8)):
+        # Surface crossings of one ray, in a direction no body axis lines up with.
+        tid = wp.tid()
+        ray = wp.normalize(wp.vec3(0.5773, 0.5774, 0.5775))
+        origin = points[tid]
+        crossings = wp.int32(0)
+        for _ in range(1024):
+            hit = wp.mesh_query_ray(mesh, origin, ray, 1.0e3)
+            if not hit.result:
+                break
+            crossings += 1
+            origin = origin + ray * (hit.t + 1.0e-6)
+        inside[tid] = wp.int8(crossings % 2)
+
+    return {"signed_distance": signed_distance, "offsets": offsets, "parity": parity}
+
+
+def signed_distance_warp(mesh: Any, points: np.ndarray) -> np.ndarray:
+    """Signed distance of ``points`` to an existing ``warp.Mesh`` (refit if it moved).
+
+    Args:
+        mesh: a ``warp.Mesh`` on the CPU.
+        points: ``(N, 3)`` [m].
+
+    Returns:
+        ``(N,)`` float32 [m], negative inside, capped at :data:`SEARCH_RADIUS`.
+    """
+    wp = import_warp()
+    kernel = _kernels()["signed_distance"]
+    points_wp = wp.array(np.ascontiguousarray(points, dtype=np.float32), dtype=wp.vec3,
+                         device="cpu")
+    out = wp.empty(len(points), dtype=float, device="cpu")
+    wp.launch(kernel, dim=len(points), inputs=[mesh.id, points_wp, SEARCH_RADIUS, out],
+              device="cpu")
+    return out.numpy().copy()
+
+
+def signed_distance(points: np.ndarray, vertices: np.ndarray,
+                    faces: np.ndarray) -> np.ndarray:
+    """Signed distance of ``points`` to the closed mesh (``vertices``, ``faces``).
+
+    Args:
+        points: ``(N, 3)`` [m].
+        vertices: ``(V, 3)`` [m]; faces ``(F, 3)`` int, outward winding.
+
+    Returns:
+        ``(N,)`` float32 [m], negative inside.
+    """
+    return signed_distance_warp(warp_mesh(vertices, faces), points)
+
+
+def surface_offsets(mesh: Any, points: np.ndarray, max_dist: float = SEARCH_RADIUS,
+                    inside: np.ndarray | None = None
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Signed distance, closest surface point and outward direction of each point.
+
+    The sign comes from the angle-weighted pseudo-normal at the closest point
+    (``wp.mesh_query_point_sign_normal``: exact for a closed, non-self-intersecting
+    mesh and cheap; points where the posed body intersects itself, e.g. between the
+    toes, can get the wrong sign) unless ``inside`` says the point is inside.
+
+    Args:
+        mesh: a closed ``warp.Mesh`` on the CPU (outward winding).
+        points: ``(N, 3)`` [m].
+        max_dist: closest points are searched this far [m]; a point with no surface
+            that close reports distance ``inf``, itself and a zero direction.
+        inside: ``(N,)`` bool, points known to be inside (e.g. by :func:`inside_by_parity`).
+
+    Returns:
+        distance ``(N,)`` [m] (negative inside), closest ``(N, 3)`` [m] and direction
+        ``(N, 3)`` (unit, outward: moving a point along it increases its signed
+        distance), float32.
+    """
+    wp = import_warp()
+    points = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
+    count = len(points)
+    known = (np.zeros(count, dtype=np.int8) if inside is None
+             else np.ascontiguousarray(inside, dtype=np.int8).reshape(count))
+    distance = wp.empty(count, dtype=float, device="cpu")
+    closest = wp.empty(count, dtype=wp.vec3, device="cpu")
+    direction = wp.empty(count, dtype=wp.vec3, device="cpu")
+    if count:
+        wp.launch(_kernels()["offsets"], dim=count,
+                  inputs=[mesh.id, wp.array(points, dtype=wp.vec3, device="cpu"),
+                          float(max_dist), wp.array(known, dtype=wp.int8, device="cpu"),
+                          distance, closest, direction], device="cpu")
+    return (distance.numpy().copy(), closest.numpy().reshape(count, 3).copy(),
+            direction.numpy().reshape(count, 3).copy())
+
+
+def inside_by_parity(mesh: Any, points: np.ndarray) -> np.ndarray:
+    """``(N,)`` bool: ``points (N, 3)`` inside the closed ``mesh`` by the parity of the
+    surface crossings of one ray (costs a few BVH ray casts per point)."""
+    wp = import_warp()
+    points = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
+    inside = wp.zeros(len(points), dtype=wp.int8, device="cpu")
+    if len(points):
+        wp.launch(_kernels()["parity"], dim=len(points),
+                  inputs=[mesh.id, wp.array(points, dtype=wp.vec3, device="cpu"), inside],
+                  device="cpu")
+    return inside.numpy().astype(bool)
