@@ -76,3 +76,15 @@ def synthetic_body_meshes(root: str | Path) -> Callable[[str], BodyMesh | None]:
         return vertices, model.faces
 
     return body_mesh
+
+
+def synthetic_skinning_weights(root: str | Path) -> np.ndarray | None:
+    """The body model's skinning weights ``(N_b, 24)`` for a synthetic cache (its bodies
+    are Anny's: one topology, one set of weights), ``None`` for any other cache."""
+    from gnngarment.data.cache import read_manifest
+
+    if "config" not in read_manifest(root):
+        return None
+    from gnngarment.body.anny_model import AnnyBodyModel
+
+    return AnnyBodyModel().skinning_weights()

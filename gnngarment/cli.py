@@ -245,13 +245,14 @@ def evaluate(
         raise fail(str(error)) from None
     from tqdm import tqdm
 
-    from data_prep.posed_bodies import synthetic_body_meshes
+    from data_prep.posed_bodies import synthetic_body_meshes, synthetic_skinning_weights
 
     bar = tqdm(total=len(dataset), desc=f"evaluating {split}", unit="sequence")
     report = run_evaluation({"ours": model}, dataset, spurious=spurious,
                             progress=lambda name: bar.update(1),
                             body_meshes=synthetic_body_meshes(data),
-                            collisions=_collision_settings())
+                            collisions=_collision_settings(),
+                            body_skinning_weights=synthetic_skinning_weights(data))
     bar.close()
     console.print(report.to_markdown())
     write_report(report, markdown, json_path)
@@ -416,16 +417,17 @@ def benchmark_accuracy(
         settings = load_training_config(config)
     except (ConfigError, ValueError) as error:
         raise fail(str(error)) from None
-    from data_prep.posed_bodies import synthetic_body_meshes
+    from data_prep.posed_bodies import synthetic_body_meshes, synthetic_skinning_weights
     from gnngarment.data import CacheError
 
     try:
         body_meshes = synthetic_body_meshes(settings.data)
+        skinning_weights = synthetic_skinning_weights(settings.data)
     except CacheError as error:
         raise fail(str(error)) from None
     result = run_benchmark(settings, output, variant, split,
                            command="gnngarment " + " ".join(sys.argv[1:]),
-                           body_meshes=body_meshes)
+                           body_meshes=body_meshes, body_skinning_weights=skinning_weights)
     console.print(f"[green]wrote[/] {output}: {len(result['rows'])} rows")
 
 

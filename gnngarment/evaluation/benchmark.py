@@ -8,6 +8,8 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from gnngarment.data.dataset import PreparedDataset
 from gnngarment.evaluation.evaluate import METRICS, BodyMeshes, evaluate
 from gnngarment.geometry.files import atomic_write_bytes
@@ -15,19 +17,22 @@ from gnngarment.training.checkpoint import load_model
 from gnngarment.training.config import TrainingConfig
 from gnngarment.training.trainer import CHECKPOINT_NAME, SUPERVISED_CHECKPOINT_NAME, Trainer
 
-#: name → (levels, pooling); every variant shares all other settings.
-VARIANTS = {
-    "ours (2 levels)": (2, "structure"),
-    "single level": (0, "structure"),
-    "TopKPool": (2, "topk"),
-    "SAGPool": (2, "sag"),
-    "ASAPool": (2, "asap"),
+#: name → the model settings it changes; every variant shares all other settings
+#: (the skinning-weight prior of the config included, except for the paper's head).
+VARIANTS: dict[str, dict[str, Any]] = {
+    "ours (2 levels)": {"levels": 2, "pooling": "structure"},
+    "ours, paper's weight head": {"levels": 2, "pooling": "structure", "weight_prior": "none"},
+    "single level": {"levels": 0, "pooling": "structure"},
+    "TopKPool": {"levels": 2, "pooling": "topk"},
+    "SAGPool": {"levels": 2, "pooling": "sag"},
+    "ASAPool": {"levels": 2, "pooling": "asap"},
 }
 
 
 def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | None = None,
                   split: str = "test", command: str = "",
-                  body_meshes: BodyMeshes | None = None) -> dict[str, Any]:
+                  body_meshes: BodyMeshes | None = None,
+                  body_skinning_weights: np.ndarray | None = None) -> dict[str, Any]:
     """Train every variant with ``config`` (levels/pooling changed only), evaluate each
     before and after the physics stage, and write ``output`` (Markdown). ``body_meshes``
     gives the posed body meshes the evaluation resolves collisions against
@@ -38,10 +43,9 @@ def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | No
     seconds: dict[str, float] = {}
     lbs: dict[str, dict[str, float]] | None = None
     for name in names:
-        levels, pooling = VARIANTS[name]
-        variant = replace(config, output=str(Path(config.output) / name.replace(" ", "_")
-                                                 .replace("(", "").replace(")", "")),
-                          model=replace(config.model, levels=levels, pooling=pooling))
+        folder = "".join(c for c in name.replace(" ", "_") if c.isalnum() or c == "_")
+        variant = replace(config, output=str(Path(config.output) / folder),
+                          model=replace(config.model, **VARIANTS[name]))
         started = time.perf_counter()
         train = PreparedDataset(variant.data, "train", variant.model.window)
         trainer = Trainer(variant, train, None, progress=True)
@@ -55,7 +59,8 @@ def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | No
             if not path.is_file():
                 continue
             report = evaluate({name: load_model(path)}, test, body_skinning=lbs is None,
-                              body_meshes=body_meshes)
+                              body_meshes=body_meshes,
+                              body_skinning_weights=body_skinning_weights)
             results[f"{name}, {label}"] = report.results[name]
             if lbs is None and "body skinning (draped template)" in report.results:
                 lbs = report.results["body skinning (draped template)"]

@@ -26,7 +26,9 @@ from gnngarment.model.deformer import GarmentDeformer
 #: garment after collision resolution; ``raw_*`` are of the network's (or baseline's)
 #: own output before it.
 METRICS = ("e_verts_mm", "raw_e_verts_mm", "e_norm_deg", "collision_pct", "raw_collision_pct",
-           "hausdorff_mm", "sted", "spurious_mm")
+           "hausdorff_mm", "sted", "spurious_mm", "far_weight_pct")
+#: Metrics aggregated by their maximum over sequences, not their frame-weighted mean.
+MAXIMUM_METRICS = ("far_weight_pct",)
 
 #: The posed body mesh of a sequence: ``(T, N_b, 3)`` vertices and ``(F_b, 3)`` faces,
 #: or ``None`` where it is not known.
@@ -88,9 +90,11 @@ class EvaluationReport:
 @torch.inference_mode()
 def predict(model: GarmentDeformer, dataset: PreparedDataset, name: str,
             motion_features: np.ndarray | None = None,
-            joint_transforms: np.ndarray | None = None, chunk: int = 16) -> np.ndarray:
+            joint_transforms: np.ndarray | None = None, chunk: int = 16,
+            return_weights: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """The model's garment for every frame of a sequence, ``(T, N, 3)``; optionally with
-    replaced motion features ``(T, 75)`` / joint transforms ``(T, 24, 4, 4)``."""
+    replaced motion features ``(T, 75)`` / joint transforms ``(T, 24, 4, 4)``. With
+    ``return_weights``, also its skinning weights ``(T, N, 24)``."""
     model.eval()
     record = dataset.sequence(name)
     garment = dataset.garment_of(name)
@@ -100,13 +104,17 @@ def predict(model: GarmentDeformer, dataset: PreparedDataset, name: str,
     transforms = torch.from_numpy(record.joint_transforms if joint_transforms is None
                                   else joint_transforms)
     velocity = torch.from_numpy(record.velocities.reshape(record.num_frames, -1))
-    out = []
+    out, weights = [], []
     for start in range(0, record.num_frames, chunk):
         frames = np.arange(start, min(start + chunk, record.num_frames))
         windows = torch.from_numpy(window_indices(frames, model.config.window))
         result = model(context, features[windows][None], velocity[windows][None],
                        transforms[frames][None])
         out.append(result.posed.view(len(frames), -1, 3))
+        if return_weights:
+            weights.append(result.weights.view(len(frames), -1, result.weights.shape[-1]))
+    if return_weights:
+        return torch.cat(out).numpy(), torch.cat(weights).numpy()
     return torch.cat(out).numpy()
 
 
@@ -191,8 +199,10 @@ def _aggregate(per_sequence: dict[str, dict[str, float]], types: dict[str, str],
     for garment_type, names in grouped.items():
         weights = np.array([frames[n] for n in names], dtype=np.float64)
         result[garment_type] = {
-            metric: float(np.average([per_sequence[n].get(metric, np.nan) for n in names],
-                                     weights=weights))
+            metric: (float(np.max([per_sequence[n].get(metric, np.nan) for n in names]))
+                     if metric in MAXIMUM_METRICS else
+                     float(np.average([per_sequence[n].get(metric, np.nan) for n in names],
+                                      weights=weights)))
             for metric in METRICS}
     return result
 
@@ -201,7 +211,8 @@ def evaluate(models: dict[str, GarmentDeformer], dataset: PreparedDataset,
              body_skinning: bool = True, spurious: bool = True,
              progress: Callable[[str], None] | None = None,
              body_meshes: BodyMeshes | None = None,
-             collisions: CollisionSettings | None = None) -> EvaluationReport:
+             collisions: CollisionSettings | None = None,
+             body_skinning_weights: np.ndarray | None = None) -> EvaluationReport:
     """Metrics of every model in ``models`` (and the body-skinning baseline) on every
     sequence of ``dataset``'s split, after collision resolution as
     :func:`~gnngarment.inference.animate.animate` does it, with the raw output's
@@ -218,6 +229,11 @@ def evaluate(models: dict[str, GarmentDeformer], dataset: PreparedDataset,
             samples); sequences without one are evaluated unresolved
             (``EvaluationReport.unresolved``).
         collisions: ``ε`` and smoothing; default :class:`CollisionSettings`.
+        body_skinning_weights: ``(N_b, 24)`` the body model's skinning weights; with
+            ``body_meshes`` it gives ``far_weight_pct``: the largest share (%) of any
+            vertex's skinning weight on joints whose body region is more than 20 cm from
+            it (:func:`~gnngarment.evaluation.metrics.far_joint_weight`; frame 0 of a
+            body mesh is its rest pose).
     """
     report = EvaluationReport(split=dataset.split)
     types = {n: dataset.garment_of(n).garment_type for n in dataset.sequence_names}
@@ -230,9 +246,14 @@ def evaluate(models: dict[str, GarmentDeformer], dataset: PreparedDataset,
         body_mesh = body_meshes(name) if body_meshes is not None else None
         if body_mesh is None:
             report.unresolved.append(name)
+        regions = body_mesh is not None and body_skinning_weights is not None
+        rest = dataset.garment_of(name).pair.rest_pos.numpy()
         for method, model in models.items():
-            pred = predict(model, dataset, name)
+            pred, weights = predict(model, dataset, name, return_weights=True)
             values = resolved_sequence_metrics(pred, dataset, name, body_mesh, collisions)
+            if regions:
+                values["far_weight_pct"] = 100 * metrics.far_joint_weight(
+                    weights, rest, body_mesh[0][0], body_skinning_weights)["max"]
             if spurious:
                 values["spurious_mm"] = spurious_change(model, dataset, name, pred)
             methods[method][name] = values
@@ -240,6 +261,11 @@ def evaluate(models: dict[str, GarmentDeformer], dataset: PreparedDataset,
             pred = body_skinning_prediction(dataset, name)
             if pred is not None:
                 values = resolved_sequence_metrics(pred, dataset, name, body_mesh, collisions)
+                if regions:
+                    garment_weights = read_garment(dataset.root, dataset.manifest["sequences"]
+                                                   [name]["garment"]).body_weights
+                    values["far_weight_pct"] = 100 * metrics.far_joint_weight(
+                        garment_weights, rest, body_mesh[0][0], body_skinning_weights)["max"]
                 if spurious:
                     values["spurious_mm"] = spurious_change(None, dataset, name, pred)
                 methods["body skinning (draped template)"][name] = values

@@ -9,7 +9,12 @@ import torch
 
 from gnngarment.data import PreparedDataset
 from gnngarment.evaluation import evaluate, write_report
-from gnngarment.evaluation.evaluate import METRICS, resolved_sequence_metrics, sequence_metrics
+from gnngarment.evaluation.evaluate import (
+    METRICS,
+    predict,
+    resolved_sequence_metrics,
+    sequence_metrics,
+)
 from gnngarment.model import GarmentDeformer
 from tests.meshes import closed_box
 from tests.model.pairs import tiny_config
@@ -81,3 +86,26 @@ def test_evaluate_resolves_every_method_where_the_body_mesh_is_known(cache: Path
                 assert values["e_verts_mm"] == values["raw_e_verts_mm"]
     assert "raw_collision_pct" in report.to_markdown()
     assert json.loads(report.to_json())["unresolved"] == report.unresolved
+
+
+def test_far_joint_weight_is_reported_per_method(cache: Path) -> None:
+    """With the body's skinning weights, evaluate reports the largest share of a vertex's
+    weight on far joints (issue 12 §3): all on a joint whose region is far → 100 %."""
+    torch.manual_seed(0)
+    model = GarmentDeformer(tiny_config())
+    dataset = PreparedDataset(cache, "test", model.config.window)
+    first = dataset.sequence_names[0]
+    # A "body" on the garment itself, every vertex of it belonging to joint 0 (near);
+    # joints 1-23 dominate no body vertex: far.
+    garment = dataset.garment_of(first)
+    vertices = np.repeat(garment.pair.rest_pos.numpy()[None], dataset.frame_counts[first], 0)
+    faces = garment.faces.numpy()
+    near = np.zeros((vertices.shape[1], 24), dtype=np.float32)
+    near[:, 0] = 1.0
+    report = evaluate({"ours": model}, dataset, spurious=False,
+                      body_meshes={first: (vertices, faces)}.get, body_skinning_weights=near)
+    values = report.sequences["ours"][first]
+    weights = predict(model, dataset, first, return_weights=True)[1]
+    far = 100 * weights[..., 1:].sum(-1).max()
+    assert values["far_weight_pct"] == pytest.approx(far, rel=1e-3) and far > 0
+    assert "far_weight_pct" not in report.sequences["ours"][dataset.sequence_names[1]]
