@@ -13,7 +13,14 @@ __all__ = ["Animation", "animate", "garment_pair"]
 
 def __getattr__(name: str) -> Any:
     if name in __all__:
-        from gnngarment.inference import animate as module
+        # importlib, not ``from gnngarment.inference import animate``: that statement looks
+        # the name up on this package, i.e. calls this function again (RecursionError),
+        # and once the submodule is loaded it would hand out the module, not the function.
+        import importlib
 
-        return getattr(module, name)
+        module = importlib.import_module("gnngarment.inference.animate")
+        # Importing the submodule bound the name ``animate`` to the module: rebind every
+        # public name to its object, so later look-ups never reach the module.
+        globals().update({public: getattr(module, public) for public in __all__})
+        return globals()[name]
     raise AttributeError(f"module 'gnngarment.inference' has no attribute {name!r}")

@@ -106,7 +106,7 @@ class GarmentDeformer(nn.Module):
         width = config.feature_channels
         self.garment_encoder = GarmentGraphEncoder(VERTEX_FEATURE_CHANNELS,
                                                    list(config.garment_channels), NUM_JOINTS,
-                                                   config.dropout)
+                                                   config.dropout, attention=config.attention)
         self.style_encoder = StyleEncoder(config.landmarks, list(config.style_channels))
         self.body_encoder = BodyShapeEncoder(config.body_vertices, list(config.body_channels))
         self.pose_encoder = MotionEncoder(MOTION_CHANNELS, config.motion_hidden,
@@ -119,7 +119,7 @@ class GarmentDeformer(nn.Module):
             return MultilevelProcessor(width * NUM_JOINTS, config.processor_channels,
                                        config.processor_heads, 3, config.output_heads,
                                        config.levels, config.pooling, config.pooling_ratio,
-                                       config.dropout)
+                                       config.dropout, attention=config.attention)
 
         self.supervised_processor = processor()
         # Blend shapes are corrections of centimetres: a Glorot-initialised output GAT

@@ -337,3 +337,18 @@ def test_unknown_attention_is_rejected() -> None:
         graph_attention(4, 4, 2, concat=True, attention="dense")
     with pytest.raises(ValueError, match="attention"):
         GarmentDeformer(tiny_config(attention="dense"))
+
+
+def test_the_model_config_picks_the_attention_implementation() -> None:
+    """``attention: pyg`` in a model config builds GATConv layers by itself (issue 16: the
+    deformer ignored the setting; no set_attention call here)."""
+    from torch_geometric.nn import GATConv
+
+    from gnngarment.model import GarmentDeformer
+    from gnngarment.model.graph_attention import GraphAttention
+    from tests.model.pairs import tiny_config
+
+    for attention, layer_type in (("pyg", GATConv), ("csr", GraphAttention)):
+        model = GarmentDeformer(tiny_config(attention=attention))
+        layers = [m for m in model.modules() if isinstance(m, GATConv | GraphAttention)]
+        assert layers and all(isinstance(m, layer_type) for m in layers), attention

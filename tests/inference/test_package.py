@@ -1,0 +1,16 @@
+"""The package's lazy exports (issue 16: ``gnngarment.inference.Animation`` recursed and
+``animate`` named the module once it was loaded)."""
+
+import subprocess
+import sys
+
+
+def test_lazy_exports_are_the_objects_in_a_fresh_interpreter() -> None:
+    code = ("import inspect, gnngarment.inference as package\n"
+            "assert inspect.isclass(package.Animation)\n"
+            "assert inspect.isfunction(package.animate), package.animate\n"
+            "assert inspect.isfunction(package.garment_pair)\n"
+            "from gnngarment.inference.animate import animate\n"
+            "assert package.animate is animate\n")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr[-2000:]
