@@ -600,6 +600,7 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
         "output": str(root), "seconds": time.perf_counter() - started,
         "planned": len(plans), "skipped_existing": skipped, "simulated": len(results),
         "failed_sequences": failed, "failed_garments": failed_garments,
+        "losses_by_reason": losses_by_reason(failed, failed_garments, plans),
         "splits": {k: len(v) for k, v in splits.items()},
         "seconds_per_frame": float(np.mean([r["seconds_per_frame"] for r in results
                                             if r["ok"]])) if any(r["ok"] for r in results)
@@ -608,6 +609,36 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
     }
     atomic_write_bytes(root / "build_report.json", json.dumps(report, indent=2).encode())
     return report
+
+
+#: Reason a planned sequence was lost → the words that identify it in its message.
+LOSS_REASONS = {
+    "drape failed": ("drape:",),
+    "left the body": ("slid off the body",),
+    "fell down the body": ("fell down the body",),
+    "edge stretch": ("stretch",),
+    "inside the body": ("inside",),
+    "not finite": ("non-finite",),
+}
+
+
+def losses_by_reason(failed_sequences: dict[str, str], failed_garments: dict[str, str],
+                     plans: list[SequencePlan]) -> dict[str, int]:
+    """How many planned sequences each kind of failure removed (a failed garment drape
+    removes all of its sequences), plus ``planned`` and ``lost`` in total."""
+    counts: dict[str, int] = {}
+
+    def count(reason: str) -> None:
+        kind = next((k for k, words in LOSS_REASONS.items()
+                     if any(w in reason for w in words)), "other")
+        counts[kind] = counts.get(kind, 0) + 1
+
+    for plan in plans:
+        if plan.garment in failed_garments:
+            count(failed_garments[plan.garment])
+        elif plan.name in failed_sequences:
+            count(failed_sequences[plan.name])
+    return {"planned": len(plans), "lost": sum(counts.values()), **counts}
 
 
 def _warm_up_kernels(log: Callable[[str], None]) -> None:

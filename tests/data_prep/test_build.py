@@ -182,3 +182,19 @@ def test_bad_config_values_name_the_file_and_key(tmp_path: Path, override: dict,
     path.write_text(OmegaConf.to_yaml(values))
     with pytest.raises(ConfigError, match=rf"{path}: key '{key}'"):
         load_config(path, DataConfig)
+
+
+def test_losses_are_counted_by_reason(tmp_path: Path) -> None:
+    from data_prep.build import losses_by_reason
+
+    plans = plan_dataset(tiny_config(tmp_path))
+    garment = plans[0].garment
+    on_that_garment = sum(p.garment == garment for p in plans)
+    others = [p for p in plans if p.garment != garment]
+    counts = losses_by_reason(
+        {others[0].name: "garment slid off the body: mean distance 0.20 m > 0.15 m at frame 3",
+         others[1].name: "simulation failed after 2 attempt(s): attempt 1: frame 4: max edge "
+                         "stretch 1.700 > 1.500"},
+        {garment: "drape: garment fell down the body: mean drop 0.30 m > 0.15 m"}, plans)
+    assert counts == {"planned": len(plans), "lost": on_that_garment + 2,
+                      "drape failed": on_that_garment, "left the body": 1, "edge stretch": 1}
