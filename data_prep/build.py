@@ -443,11 +443,24 @@ def _known_failure(root: Path, name: str, inputs_hash: str,
     return record.get("reason") if record.get("inputs_hash") == inputs_hash else None
 
 
+def _intact_npz(path: Path) -> bool:
+    """Whether ``path`` is a whole ``.npz``: its zip directory reads and every member
+    matches its CRC (a truncated or damaged file is rebuilt, not counted as built)."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as archive:
+            return archive.testzip() is None
+    except (OSError, EOFError, zipfile.BadZipFile):
+        return False
+
+
 def _garment_done(root: Path, name: str, inputs_hash: str) -> bool:
     hash_file = root / "garments" / f"{name}.hash"
     return ((root / "garments" / f"{name}.npz").is_file()
             and (root / "garments" / f"{name}.pins.json").is_file()
-            and hash_file.is_file() and hash_file.read_text() == inputs_hash)
+            and hash_file.is_file() and hash_file.read_text() == inputs_hash
+            and _intact_npz(root / "garments" / f"{name}.npz"))
 
 
 def _garment_summary(root: Path, name: str) -> dict[str, Any]:
@@ -465,7 +478,8 @@ def _garment_summary(root: Path, name: str) -> dict[str, Any]:
 def _sequence_done(root: Path, name: str, inputs_hash: str) -> bool:
     hash_file = root / "sequences" / f"{name}.hash"
     return ((root / "sequences" / f"{name}.npz").is_file() and hash_file.is_file()
-            and hash_file.read_text() == inputs_hash)
+            and hash_file.read_text() == inputs_hash
+            and _intact_npz(root / "sequences" / f"{name}.npz"))
 
 
 def build_dataset(config: DataConfig, workers: int | None = None,

@@ -50,10 +50,14 @@ def _garment_config(config_path: Path | None, levels: int | None):
             config = GarmentPreparationConfig()
     except ConfigError as error:
         raise fail(str(error)) from None
+    from gnngarment.model.config import MAX_LEVELS
+
     if levels is not None:
-        if levels < 0:
-            raise fail(f"--levels must be >= 0, got {levels}")
+        if not 0 <= levels <= MAX_LEVELS:
+            raise fail(f"--levels must be in 0..{MAX_LEVELS} (what a model can use), got {levels}")
         config.levels = levels
+    elif not 0 <= config.levels <= MAX_LEVELS:
+        raise fail(f"{path}: key 'levels' must be in 0..{MAX_LEVELS}, got {config.levels}")
     return config
 
 
@@ -116,6 +120,12 @@ def inspect(
         text = ", ".join(map(str, shown[:8])) + (" ..." if len(shown) > 8 else "")
         table.add_row(str(k), str(n), str(e), text or "-")
     console.print(table)
+    counts = hierarchy.vertex_counts()
+    stuck = next((k for k in range(1, len(counts)) if counts[k] == counts[k - 1]), None)
+    if stuck is not None:
+        console.print(f"  [yellow]note:[/] levels {stuck}..{len(counts) - 1} do not shrink "
+                      f"any more ({counts[stuck]} vertices): this garment supports at most "
+                      f"{stuck - 1} useful level(s)")
     descriptor = prepared.descriptor
     console.print(f"style descriptor ({len(descriptor)} Nyström eigenvalues, largest first): "
                   + " ".join(f"{v:.4g}" for v in descriptor[:8]) + " ...")
@@ -185,13 +195,19 @@ def train(
 
     from gnngarment.config import ConfigError
     from gnngarment.data import CacheError, PreparedDataset
+    from gnngarment.training.checkpoint import load_checkpoint
     from gnngarment.training.loading import load_training_config
-    from gnngarment.training.trainer import Trainer
+    from gnngarment.training.trainer import CHECKPOINT_NAME, RunFolderError, Trainer
 
     try:
         settings = load_training_config(config, set_)
     except (ConfigError, ValueError) as error:
         raise fail(str(error)) from None
+    if resume:  # a missing or corrupt checkpoint is said before any work, not started over
+        try:
+            load_checkpoint(Path(settings.output) / CHECKPOINT_NAME)
+        except ValueError as error:
+            raise fail(f"--resume: {error} (drop --resume to start a new run)") from None
     if int(os.environ.get("WORLD_SIZE", "1")) > 1 and not torch.distributed.is_initialized():
         # Launched by torchrun: one process per rank, gloo on CPU (NCCL needs GPUs).
         torch.distributed.init_process_group("gloo")
@@ -205,7 +221,7 @@ def train(
     trainer = Trainer(settings, train_split, validation)
     try:
         summary = trainer.fit(resume=resume)
-    except (CacheError, FloatingPointError) as error:
+    except (CacheError, RunFolderError, FloatingPointError) as error:
         raise fail(str(error)) from None
     if trainer.rank == 0:
         console.print(f"[green]done[/]: {summary['epochs']} epochs, stage {summary['stage']}; "
@@ -248,11 +264,14 @@ def evaluate(
     from data_prep.posed_bodies import synthetic_body_meshes, synthetic_skinning_weights
 
     bar = tqdm(total=len(dataset), desc=f"evaluating {split}", unit="sequence")
-    report = run_evaluation({"ours": model}, dataset, spurious=spurious,
-                            progress=lambda name: bar.update(1),
-                            body_meshes=synthetic_body_meshes(data),
-                            collisions=_collision_settings(),
-                            body_skinning_weights=synthetic_skinning_weights(data))
+    try:  # a cache file is hash-checked when first read: a swapped one fails here
+        report = run_evaluation({"ours": model}, dataset, spurious=spurious,
+                                progress=lambda name: bar.update(1),
+                                body_meshes=synthetic_body_meshes(data),
+                                collisions=_collision_settings(),
+                                body_skinning_weights=synthetic_skinning_weights(data))
+    except CacheError as error:
+        raise fail(str(error)) from None
     bar.close()
     console.print(report.to_markdown())
     write_report(report, markdown, json_path)
@@ -321,17 +340,19 @@ def animate(
 
     from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs
     from gnngarment.geometry.errors import MeshError
-    from gnngarment.geometry.mesh_io import load_mesh
+    from gnngarment.geometry.mesh_io import load_textured_mesh
     from gnngarment.inference.animate import animate as run_animation
     from gnngarment.inference.checks import check_garment_placement, fix_placement
     from gnngarment.inference.export import export_animation
     from gnngarment.paths import SHIPPED_MODEL
     from gnngarment.training.checkpoint import load_model
 
+    if not (fps > 0 and fps != float("inf")):  # also NaN; checked before any loading
+        raise fail(f"--fps must be a finite number > 0, got {fps}")
     checkpoint = checkpoint or SHIPPED_MODEL
     try:
         model = load_model(checkpoint)
-        pos, faces = load_mesh(garment_mesh)
+        pos, faces, uv, uv_faces = load_textured_mesh(garment_mesh)
     except (MeshError, ValueError) as error:
         raise fail(str(error)) from None
     body_model, shape, motion_value = _load_body_and_motion(body_shape, motion, fps, duration)
@@ -365,6 +386,7 @@ def animate(
     except MeshError as error:
         raise fail(str(error)) from None
     bar.close()
+    animation.uv, animation.uv_faces = uv, uv_faces  # the exports carry the input's UVs
     stages: dict[str, tqdm] = {}
 
     def exported(stage: str, done: int, total: int) -> None:

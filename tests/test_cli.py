@@ -54,7 +54,8 @@ def test_bad_input_exits_2_with_a_message_and_no_traceback(tmp_path: Path) -> No
     cases = [
         ([str(tmp_path / "absent.obj")], "absent.obj: file not found"),
         ([str(broken)], "NaN/inf"),
-        ([str(broken), "--levels", "-1"], "--levels must be >= 0"),
+        ([str(broken), "--levels", "-1"], "--levels must be in 0..6"),
+        ([str(broken), "--levels", "50"], "--levels must be in 0..6"),  # was quietly capped
     ]
     bad_config = tmp_path / "garment.yaml"
     bad_config.write_text("levles: 2\n")
@@ -88,3 +89,66 @@ def test_evaluate_reports_resolved_and_raw_metrics(tmp_path: Path) -> None:
     # This cache was not built from a synthetic config: no body meshes, nothing resolved.
     assert report["unresolved"] and values["e_verts_mm"] == values["raw_e_verts_mm"]
     assert "Not resolved" in result.output
+
+
+def test_animate_refuses_a_frame_rate_that_is_not_positive(tmp_path: Path) -> None:
+    result = runner.invoke(app, ["animate", str(tmp_path / "any.obj"), "--fps", "0",
+                                 "--out", str(tmp_path / "out")])
+    assert result.exit_code == 2, result.output  # was animated at 30 fps
+    assert "--fps must be a finite number > 0, got 0.0" in " ".join(result.output.split())
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.fixture(scope="module")
+def tiny_cache(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from tests.synthetic_cache import build_synthetic_cache
+
+    return build_synthetic_cache(tmp_path_factory.mktemp("cache"), frames=4)
+
+
+def train_config(folder: Path, cache: Path, **values) -> Path:
+    from dataclasses import asdict
+
+    from omegaconf import OmegaConf
+
+    from tests.model.pairs import tiny_config
+
+    path = folder / "train.yaml"
+    OmegaConf.save(OmegaConf.create({
+        "data": str(cache), "output": str(folder / "run"), "model": asdict(tiny_config()),
+        "epochs": 1, "pairs_per_batch": 2, "frames_per_pair": 2, "threads": 1, **values}), path)
+    return path
+
+
+def test_train_refuses_what_it_cannot_do_as_asked(tiny_cache: Path, tmp_path: Path) -> None:
+    from gnngarment.model import GarmentDeformer
+    from gnngarment.training.checkpoint import model_payload, save_checkpoint
+    from tests.model.pairs import tiny_config
+
+    run = tmp_path / "run"
+    config = train_config(tmp_path, tiny_cache)
+    cases = [
+        # No checkpoint to resume: said, not silently started over.
+        (["--resume"], "--resume: " + str(run / "last.pt") + ": checkpoint not found"),
+        # No epoch would run, so no last.pt would be written.
+        (["--set", "epochs=0"], "key 'epochs': must be >= 1, got 0"),
+    ]
+    for arguments, message in cases:
+        result = runner.invoke(app, ["train", "--config", str(config), *arguments])
+        assert result.exit_code == 2, result.output
+        assert message in " ".join(result.output.split())
+        assert not run.exists()
+    # A new run into another run's folder: refused before it appends to its metrics.
+    save_checkpoint(run / "last.pt", model_payload(GarmentDeformer(tiny_config())))
+    (run / "metrics.jsonl").write_text('{"epoch": 1}\n')
+    result = runner.invoke(app, ["train", "--config", str(config)])
+    assert result.exit_code == 2, result.output
+    assert "the output folder holds another run; resume it (--resume)" in " ".join(
+        result.output.split())
+    assert (run / "metrics.jsonl").read_text() == '{"epoch": 1}\n'
+    assert sorted(p.name for p in run.iterdir()) == ["last.pt", "metrics.jsonl"]
+    (run / "last.pt").write_bytes(b"not a checkpoint")
+    result = runner.invoke(app, ["train", "--config", str(config), "--resume"])
+    assert result.exit_code == 2, result.output
+    assert "--resume: " in result.output and "not a readable" in result.output
+    assert len(result.output.strip().splitlines()) == 1  # torch's message spans many lines

@@ -115,3 +115,33 @@ def test_collisions_are_resolved_unless_turned_off(files, anny_body) -> None:
     assert min(depth["--resolve-collisions"]) >= 0.002 * 0.999
     assert min(depth["--no-resolve-collisions"]) < 0
 
+
+
+def test_input_uvs_are_carried_into_the_obj_and_glb_exports(files) -> None:
+    from gnngarment.geometry.mesh_io import read_textured_obj
+    from gnngarment.inference.export import read_glb
+
+    pos, faces = load_mesh(files["garment"])
+    # A planar projection, one corner of vertex 0 given a UV of its own: a seam there.
+    uv = np.concatenate([pos[:, :2] - pos[:, :2].min(axis=0), [[0.9, 0.9]]])
+    uv_faces = faces.copy()
+    face = int(np.flatnonzero((faces == 0).any(axis=1))[0])
+    uv_faces[face][faces[face] == 0] = len(pos)
+    corners = np.stack([faces, uv_faces], axis=-1) + 1
+    textured = files["folder"] / "textured.obj"
+    textured.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in pos.tolist())
+                        + "".join(f"vt {u!r} {v!r}\n" for u, v in uv.tolist())
+                        + "".join("f " + " ".join(f"{v}/{t}" for v, t in corner) + "\n"
+                                  for corner in corners.tolist()))
+    out = files["folder"] / "textured_out"
+    result = runner.invoke(app, ["animate", str(textured), "--checkpoint",
+                                 str(files["checkpoint"]), "--out", str(out), "--duration", "0.1",
+                                 "--format", "obj,glb", "--no-body"])
+    assert result.exit_code == 0, result.output
+    frame = read_textured_obj(out / "textured_obj" / "garment_0000.obj")
+    assert len(frame.pos) == len(pos)
+    np.testing.assert_array_equal(frame.uv_faces, uv_faces)
+    np.testing.assert_allclose(frame.uv, uv, atol=1e-6)
+    document = read_glb(out / "textured.glb").document
+    assert "TEXCOORD_0" in document["meshes"][0]["primitives"][0]["attributes"]
+    assert document["meshes"][0]["extras"]["seamSources"] == [0]

@@ -348,12 +348,17 @@ def load_motion(spec: str | Path, fps: float | None = None, **procedural) -> Mot
 
     ``procedural`` keyword arguments (duration, speed, amplitude, seed) go to
     :func:`~gnngarment.body.procedural.make_motion`.
+
+    Raises:
+        MotionError: unknown name, unreadable file, or ``fps`` not a finite number > 0.
     """
     from gnngarment.body.procedural import MOTION_LIBRARY, make_motion
 
+    if fps is not None and not (np.isfinite(fps) and fps > 0):
+        raise MotionError(f"fps must be a finite number > 0, got {fps}")
     name = str(spec)
     if name in MOTION_LIBRARY:
-        return make_motion(name, fps=fps or 30.0, **procedural)
+        return make_motion(name, **({} if fps is None else {"fps": fps}), **procedural)
     path = Path(spec)
     suffix = path.suffix.lower()
     if suffix not in MOTION_FILE_TYPES:

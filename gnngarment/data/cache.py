@@ -2,7 +2,7 @@
 
 Layout under a cache root (every file written atomically; ``manifest.json`` last)::
 
-    manifest.json                 format version, code version, splits, sha256 of files
+    manifest.json                 format version, code version, splits, sha256 and size of files
     topologies/<topology>.npz     pooling hierarchy (one per garment topology)
     garments/<garment>.npz        a garment on its rest body: rest_pos, faces, descriptor
     bodies/<body>.npz             rest joints, body-shape feature D, subset indices
@@ -240,10 +240,53 @@ def verify_cache(root: str | Path) -> list[str]:
     return problems
 
 
+def check_file_sizes(root: str | Path, manifest: dict) -> None:
+    """Cheap check (one ``stat`` per file) that every file the manifest lists exists with
+    the size it was written with. A manifest written before sizes were recorded (no
+    ``sizes`` key) gets the existence check only.
+
+    Raises:
+        CacheError: the first missing or resized file (names it).
+    """
+    root = Path(root)
+    sizes = manifest.get("sizes", {})
+    for relative in manifest.get("files", {}):
+        path = root / relative
+        try:
+            size = path.stat().st_size
+        except OSError:
+            raise CacheError(f"{path}: listed in the manifest but missing; rebuild the cache "
+                             "with `gnngarment prepare`") from None
+        if relative in sizes and size != sizes[relative]:
+            raise CacheError(f"{path}: {size} bytes, the manifest says {sizes[relative]} "
+                             "(truncated or replaced); rebuild the cache with "
+                             "`gnngarment prepare`")
+
+
+def check_file_hash(root: str | Path, manifest: dict, relative: str) -> None:
+    """Check one cache file (``relative`` to ``root``, e.g. ``sequences/x.npz``) against
+    the sha256 the manifest lists for it: catches a file swapped for another of the same
+    size, which :func:`check_file_sizes` cannot.
+
+    Raises:
+        CacheError: not listed, or content differs (names the file).
+    """
+    path = Path(root) / relative
+    expected = manifest.get("files", {}).get(relative)
+    if expected is None:
+        raise CacheError(f"{path}: not listed in the manifest (added after the cache was "
+                         "built); rebuild the cache with `gnngarment prepare`")
+    if file_hash(path) != expected:
+        raise CacheError(f"{path}: content differs from the manifest (sha256 mismatch): "
+                         "changed, truncated or swapped for another file since the cache "
+                         "was built; rebuild the cache with `gnngarment prepare`")
+
+
 def write_manifest(root: str | Path, splits: dict[str, list[str]],
                    sequences: dict[str, dict], extra: dict | None = None) -> dict:
     """Write ``manifest.json`` (the commit point of a build) listing every cache file
-    with its sha256, the splits and per-sequence info (garment, body, motion, frames).
+    with its sha256 (``files``) and byte size (``sizes``), the splits and per-sequence
+    info (garment, body, motion, frames).
 
     Raises:
         CacheError: a split names a sequence without a file.
@@ -257,7 +300,9 @@ def write_manifest(root: str | Path, splits: dict[str, list[str]],
              for folder in ("topologies", "garments", "bodies", "sequences")
              for path in sorted((root / folder).glob("*.npz"))}
     digest = hashlib.sha256(json.dumps(files, sort_keys=True).encode()).hexdigest()
+    sizes = {relative: (root / relative).stat().st_size for relative in files}
     manifest = {"format_version": CACHE_FORMAT_VERSION, "splits": splits,
-                "sequences": sequences, "files": files, "hash": digest, **(extra or {})}
+                "sequences": sequences, "files": files, "sizes": sizes, "hash": digest,
+                **(extra or {})}
     write_json_atomic(root / "manifest.json", manifest)
     return manifest

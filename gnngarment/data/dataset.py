@@ -14,6 +14,8 @@ from gnngarment.body.skeleton import NUM_JOINTS
 from gnngarment.data.cache import (
     CacheError,
     SequenceRecord,
+    check_file_hash,
+    check_file_sizes,
     read_body,
     read_garment,
     read_manifest,
@@ -95,6 +97,10 @@ def window_indices(frames: np.ndarray, window: int) -> np.ndarray:
 class PreparedDataset:
     """One split of a prepared cache.
 
+    The cache is checked against its manifest: every listed file's size when the
+    dataset is made (a ``stat`` each), and a file's sha256 the first time this dataset
+    reads it (once per file, so its cost is one extra read of what is read anyway).
+
     Args:
         root: cache folder (holds ``manifest.json``).
         split: ``train``, ``val`` or ``test`` (or any split the manifest lists).
@@ -115,18 +121,30 @@ class PreparedDataset:
         self.sequence_names: list[str] = list(splits[split])
         self.frame_counts: dict[str, int] = {
             name: int(self.manifest["sequences"][name]["frames"]) for name in self.sequence_names}
+        check_file_sizes(self.root, self.manifest)
+        self._verified: set[str] = set()
         self._sequence = lru_cache(maxsize=cache_sequences)(self._read_sequence)
         self._garment = lru_cache(maxsize=None)(self._read_garment)
 
     def __len__(self) -> int:
         return len(self.sequence_names)
 
+    def _verify(self, relative: str) -> None:
+        """Check a file's sha256 against the manifest, the first time it is read."""
+        if relative not in self._verified:
+            check_file_hash(self.root, self.manifest, relative)
+            self._verified.add(relative)
+
     def _read_sequence(self, name: str) -> SequenceRecord:
+        self._verify(f"sequences/{name}.npz")
         return read_sequence(self.root, name)
 
     def _read_garment(self, garment: str, body: str) -> _GarmentData:
+        self._verify(f"garments/{garment}.npz")
+        self._verify(f"bodies/{body}.npz")
         record = read_garment(self.root, garment)
         body_record = read_body(self.root, body)
+        self._verify(f"topologies/{record.topology}.npz")
         hierarchy = read_topology(self.root, record.topology)
         if hierarchy.num_vertices != len(record.rest_pos):
             raise CacheError(f"{self.root}/topologies/{record.topology}.npz: hierarchy has "

@@ -15,7 +15,7 @@ from gnngarment.geometry.geodesics import farthest_point_sampling, geodesic_dist
 from gnngarment.geometry.graph import adjacency_matrix, connected_components, edge_index_from_faces
 from gnngarment.geometry.hierarchy import PoolHierarchy, PoolLevel, pool_hierarchy
 from gnngarment.geometry.joint_distances import joint_distances
-from gnngarment.geometry.mesh_io import load_mesh
+from gnngarment.geometry.mesh_io import TexturedMesh, load_mesh, load_textured_mesh
 from gnngarment.geometry.normals import face_normals, vertex_normals
 from gnngarment.geometry.nystrom import nystrom_descriptor
 from gnngarment.geometry.pooling import PooledGraph, pool
@@ -31,11 +31,11 @@ from gnngarment.geometry.validation import (
 
 __all__ = [
     "CollisionSettings", "CollisionStats", "GarmentPreparationConfig", "MeshError",
-    "MeshReport", "PoolHierarchy", "PoolLevel", "PooledGraph", "PreparedGarment",
+    "MeshReport", "PoolHierarchy", "PoolLevel", "PooledGraph", "PreparedGarment", "TexturedMesh",
     "adjacency_matrix", "check_mesh", "connected_components", "edge_index_from_faces",
     "face_normals", "farthest_point_sampling", "geodesic_distances", "graph_centres",
-    "hop_distance", "joint_distances", "load_mesh", "mesh_scale", "nystrom_descriptor",
-    "pool", "pool_hierarchy", "prepare_garment", "remove_unreferenced_vertices",
-    "resolve_collisions", "surface_area", "unpooling_matrix", "validate_mesh",
-    "vertex_areas", "vertex_normals",
+    "hop_distance", "joint_distances", "load_mesh", "load_textured_mesh", "mesh_scale",
+    "nystrom_descriptor", "pool", "pool_hierarchy", "prepare_garment",
+    "remove_unreferenced_vertices", "resolve_collisions", "surface_area", "unpooling_matrix",
+    "validate_mesh", "vertex_areas", "vertex_normals",
 ]

@@ -56,6 +56,11 @@ class Animation:
     raw_rest_pos: np.ndarray | None = None
     collisions: CollisionStats | None = None
     rest_collisions: CollisionStats | None = None
+    #: The input garment's texture coordinates, ``uv (K, 2)`` (OBJ convention) and per-
+    #: corner ``uv_faces (F, 3)`` (:mod:`gnngarment.geometry.texture_coordinates`), or
+    #: ``None``; the exporters write them (OBJ ``vt``, glb ``TEXCOORD_0``).
+    uv: np.ndarray | None = None
+    uv_faces: np.ndarray | None = None
 
 
 def garment_pair(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,

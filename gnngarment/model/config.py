@@ -18,6 +18,10 @@ ATTENTION_IMPLEMENTATIONS = ("csr", "pyg")
 #: paper's head, a plain softmax of the learned logits.
 WEIGHT_PRIORS = ("body", "none")
 
+#: Most pooling levels of the multilevel processor (and of a garment's hierarchy that a
+#: model can use); a small garment stops shrinking well before this.
+MAX_LEVELS = 6
+
 
 @dataclass
 class ModelConfig:
@@ -98,8 +102,8 @@ class ModelConfig:
         if self.weight_prior not in WEIGHT_PRIORS:
             raise ValueError(f"weight_prior must be one of {WEIGHT_PRIORS}, "
                              f"got '{self.weight_prior}'")
-        if not 0 <= self.levels <= 6:
-            raise ValueError(f"levels must be in 0..6, got {self.levels}")
+        if not 0 <= self.levels <= MAX_LEVELS:
+            raise ValueError(f"levels must be in 0..{MAX_LEVELS}, got {self.levels}")
         if not 0 < self.pooling_ratio < 1:
             raise ValueError(f"pooling_ratio must be in (0, 1), got {self.pooling_ratio}")
         for name in ("motion_layers", "processor_channels", "processor_heads", "output_heads",

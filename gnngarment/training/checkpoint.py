@@ -1,7 +1,9 @@
-"""Checkpoints: written atomically, loaded with ``weights_only=True``."""
+"""Checkpoints: written atomically with a content hash, loaded with ``weights_only=True``
+and checked against the hash."""
 
 from __future__ import annotations
 
+import hashlib
 import random
 from dataclasses import asdict
 from pathlib import Path
@@ -16,20 +18,83 @@ from gnngarment.model.config import ModelConfig
 from gnngarment.model.deformer import GarmentDeformer
 
 CHECKPOINT_FORMAT_VERSION = 1
+#: Key of the payload's sha256 (:func:`content_hash`); checkpoints saved before it have none.
+CONTENT_HASH_KEY = "content_hash"
+#: Key of the :func:`runtime_environment` a checkpoint was made in.
+ENVIRONMENT_KEY = "environment"
+
+
+def _hash_value(digest: Any, value: Any) -> None:
+    """Feed ``value`` into ``digest`` in an order that does not depend on dict insertion
+    order; tensors contribute dtype, shape and raw bytes."""
+    if isinstance(value, torch.Tensor):
+        tensor = value.detach().cpu().contiguous()
+        digest.update(f"tensor {tensor.dtype} {tuple(tensor.shape)};".encode())
+        digest.update(tensor.reshape(-1).view(torch.uint8).numpy().tobytes())
+    elif isinstance(value, dict):
+        digest.update(f"dict {len(value)};".encode())
+        for key in sorted(value, key=repr):
+            digest.update(f"{key!r}:".encode())
+            _hash_value(digest, value[key])
+    elif isinstance(value, (list, tuple)):  # torch.load may turn one into the other
+        digest.update(f"list {len(value)};".encode())
+        for item in value:
+            _hash_value(digest, item)
+    else:  # str, int, float, bool, None: repr is exact (floats round-trip)
+        digest.update(f"{type(value).__name__} {value!r};".encode())
+
+
+def content_hash(payload: dict[str, Any]) -> str:
+    """sha256 (hex) of a checkpoint payload: every tensor's bytes and every other value,
+    keys in sorted order, the stored hash itself left out."""
+    digest = hashlib.sha256()
+    _hash_value(digest, {k: v for k, v in payload.items() if k != CONTENT_HASH_KEY})
+    return digest.hexdigest()
+
+
+def runtime_environment() -> dict[str, Any]:
+    """What a run's numbers depend on besides its config and seed: torch's thread
+    counts and the versions of python, torch, numpy, torch_geometric and gnngarment
+    (``None`` for a package that is not installed)."""
+    import platform
+    from importlib.metadata import PackageNotFoundError, version
+
+    def installed(name: str) -> str | None:
+        try:
+            return version(name)
+        except PackageNotFoundError:
+            return None
+
+    return {"torch_threads": torch.get_num_threads(),
+            "torch_interop_threads": torch.get_num_interop_threads(),
+            "python": platform.python_version(), "torch": str(torch.__version__),
+            "numpy": str(np.__version__), "torch_geometric": installed("torch_geometric"),
+            "gnngarment": installed("gnngarment")}
 
 
 def save_checkpoint(path: str | Path, payload: dict[str, Any]) -> None:
     """``torch.save`` to a temp file in the same folder, then rename: a kill -9 during
-    the write leaves the previous checkpoint intact."""
-    atomic_write(path, lambda stream: torch.save(
-        {"format_version": CHECKPOINT_FORMAT_VERSION, **payload}, stream))
+    the write leaves the previous checkpoint intact.
+
+    Adds ``format_version``, the :func:`runtime_environment` (unless ``payload`` carries
+    one already, as a released checkpoint keeps its training run's) and the
+    :func:`content_hash` that :func:`load_checkpoint` checks.
+    """
+    payload = {"format_version": CHECKPOINT_FORMAT_VERSION,
+               ENVIRONMENT_KEY: runtime_environment(),
+               **{k: v for k, v in payload.items() if k != CONTENT_HASH_KEY}}
+    payload[CONTENT_HASH_KEY] = content_hash(payload)
+    atomic_write(path, lambda stream: torch.save(payload, stream))
 
 
 def load_checkpoint(path: str | Path) -> dict[str, Any]:
-    """Load a checkpoint safely (no pickled code: ``weights_only=True``).
+    """Load a checkpoint safely (no pickled code: ``weights_only=True``) and check its
+    content hash. A checkpoint saved before hashes were stored (no ``content_hash``
+    key, e.g. the shipped ``models/gnngarment-small.pt`` of 0.1.0) loads unchecked.
 
     Raises:
-        ValueError: missing, truncated or foreign file (names it).
+        ValueError: missing, truncated, corrupt (content hash mismatch) or foreign file
+            (names it).
     """
     path = Path(path)
     if not path.is_file():
@@ -37,10 +102,22 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
     try:
         payload = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as error:  # truncated zip, unpickling refusal, ...
-        raise ValueError(f"{path}: not a readable gnngarment checkpoint ({error})") from error
+        lines = [line.strip() for line in str(error).splitlines() if line.strip()]
+        if lines and lines[0].startswith("Weights only load failed"):
+            # torch's message spans many lines; its gist is the last one before the link.
+            lines = [line for line in lines if not line.startswith("Check the documentation")]
+            gist = lines[-1].removeprefix("WeightsUnpickler error:").strip().split(". ")[0]
+            detail = f"refused by weights-only loading: {gist}"
+        else:
+            detail = lines[0] if lines else type(error).__name__
+        raise ValueError(f"{path}: not a readable gnngarment checkpoint ({detail})") from error
     if not isinstance(payload, dict) or payload.get("format_version") != CHECKPOINT_FORMAT_VERSION:
         raise ValueError(f"{path}: not a gnngarment checkpoint (format "
                          f"{payload.get('format_version') if isinstance(payload, dict) else '?'})")
+    stored = payload.get(CONTENT_HASH_KEY)
+    if stored is not None and stored != content_hash(payload):
+        raise ValueError(f"{path} is corrupt: content hash mismatch (its contents changed "
+                         "after it was saved; use another copy)")
     return payload
 
 
@@ -80,7 +157,7 @@ def load_model(path: str | Path) -> GarmentDeformer:
 #: What a released (shipped) checkpoint keeps: enough to rebuild the model and to say how
 #: it was made; the optimiser, scheduler and RNG states only matter for resuming.
 RELEASE_KEYS = ("model_config", "model_state", "use_physics", "epoch", "schedule",
-                "training_config", "data_manifest_hash", "history")
+                "training_config", "data_manifest_hash", "history", ENVIRONMENT_KEY)
 
 
 def release_checkpoint(source: str | Path, destination: str | Path) -> Path:

@@ -2,9 +2,25 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
+from dataclasses import dataclass, field, fields
 
 from gnngarment.model.config import ModelConfig
+
+#: Stages with an entry in ``stages.max_epochs`` (the schedule's order).
+TRAINED_STAGES = ("supervised", "physics", "physics_strain")
+
+
+def _check_at_least(key: str, value: int, low: int) -> None:
+    if value < low:
+        raise ValueError(f"key '{key}': must be >= {low}, got {value}")
+
+
+def _check_finite(key: str, value: float, positive: bool = False) -> None:
+    """``value`` finite and ``>= 0`` (``> 0`` when ``positive``)."""
+    if not math.isfinite(value) or value < 0 or (positive and value == 0):
+        raise ValueError(f"key '{key}': must be a finite number {'>' if positive else '>='} 0, "
+                         f"got {value}")
 
 
 @dataclass
@@ -76,3 +92,28 @@ class TrainingConfig:
     collision_margin: float = 0.004
     threads: int = 0
     validate_every: int = 1
+
+    def __post_init__(self) -> None:
+        """Check ranges before any work starts (``epochs: 0`` would report a checkpoint
+        that is never written, ``learning_rate: nan`` would train to NaN). Model
+        settings are checked by :meth:`ModelConfig.validate`.
+
+        Raises:
+            ValueError: naming the key, e.g. ``key 'stages.max_epochs'``.
+        """
+        for key, low in (("seed", 0), ("epochs", 1), ("pairs_per_batch", 1),
+                         ("frames_per_pair", 1), ("threads", 0), ("validate_every", 1)):
+            _check_at_least(key, getattr(self, key), low)
+        _check_finite("learning_rate", self.learning_rate, positive=True)
+        _check_finite("collision_margin", self.collision_margin)
+        for item in fields(self.losses):
+            _check_finite(f"losses.{item.name}", getattr(self.losses, item.name))
+        stages = self.stages
+        for name in ("supervised", "collision", "strain"):
+            _check_at_least(f"stages.{name}_window", getattr(stages, f"{name}_window"), 1)
+            _check_finite(f"stages.{name}_threshold", getattr(stages, f"{name}_threshold"))
+        _check_finite("stages.physics_scale", stages.physics_scale)
+        if len(stages.max_epochs) != len(TRAINED_STAGES) or min(stages.max_epochs) < 0:
+            raise ValueError(f"key 'stages.max_epochs': expected {len(TRAINED_STAGES)} epoch "
+                             f"limits >= 0 ({', '.join(TRAINED_STAGES)}; 0 = none), got "
+                             f"{list(stages.max_epochs)}")

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from gnngarment.training.config import StageConfig
+from gnngarment.training.config import TRAINED_STAGES, StageConfig
 
-STAGES = ("supervised", "physics", "physics_strain", "done")
+STAGES = (*TRAINED_STAGES, "done")
 #: The metric each stage watches for its plateau.
 WATCHED = {"supervised": "vertex", "physics": "collision", "physics_strain": "collision"}
 

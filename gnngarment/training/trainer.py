@@ -15,6 +15,7 @@ import torch
 from torch import nn
 
 from gnngarment.data.dataset import PreparedDataset, TrainingBatch
+from gnngarment.geometry.files import atomic_write_bytes
 from gnngarment.model.deformer import DeformerOutput, GarmentDeformer
 from gnngarment.training.checkpoint import (
     load_checkpoint,
@@ -29,6 +30,12 @@ from gnngarment.training.schedule import StageSchedule
 
 CHECKPOINT_NAME = "last.pt"
 SUPERVISED_CHECKPOINT_NAME = "supervised.pt"
+METRICS_NAME = "metrics.jsonl"
+
+
+class RunFolderError(ValueError):
+    """A new run was started into a folder that holds another run's checkpoint (the
+    message names it and says how to continue or start over)."""
 
 
 class TrainingStep(nn.Module):
@@ -122,18 +129,35 @@ class Trainer:
     def fit(self, resume: bool = False, stop_after: int | None = None) -> dict[str, Any]:
         """Train until the schedule is done or ``config.epochs`` is reached.
 
+        A run folder belongs to one run: ``metrics.jsonl`` holds exactly the epochs of
+        the run's checkpoint (a fresh run starts it empty; a resumed one drops the lines
+        of epochs its checkpoint does not have, e.g. after a kill between the log line
+        and the checkpoint write).
+
         Args:
-            resume: continue from ``<output>/last.pt`` if it exists.
+            resume: continue from ``<output>/last.pt`` if it exists (a fresh run if not).
             stop_after: run at most this many epochs in this call (the run can be
                 resumed later exactly as if it had not stopped).
 
         Returns:
             A summary: final stage, stage switches, last epoch's metrics.
+
+        Raises:
+            RunFolderError: ``resume`` is false and ``<output>/last.pt`` of another run
+                exists (this trainer has not trained yet).
         """
         from torch.utils.tensorboard import SummaryWriter
 
-        if resume and self.checkpoint_path().is_file():
-            self.resume()
+        if self.checkpoint_path().is_file():
+            if resume:
+                self.resume()
+            elif self.epoch == 0:
+                raise RunFolderError(
+                    f"{self.checkpoint_path()}: the output folder holds another run; resume "
+                    "it (--resume), or choose another output folder (--set output=...) or "
+                    "delete this one to start over")
+        if self.rank == 0:
+            self._trim_metrics()
         writer = SummaryWriter(str(self.output / "tensorboard")) if self.rank == 0 else None
         last_epoch = self.config.epochs if stop_after is None else min(
             self.config.epochs, self.epoch + stop_after)
@@ -263,6 +287,22 @@ class Trainer:
         if reason is not None:
             print(f"stage switch after epoch {self.epoch}: {metrics['stage']} -> "
                   f"{self.schedule.stage} ({reason})", flush=True)
-        (self.output / "metrics.jsonl").parent.mkdir(parents=True, exist_ok=True)
-        with open(self.output / "metrics.jsonl", "a") as stream:
+        (self.output / METRICS_NAME).parent.mkdir(parents=True, exist_ok=True)
+        with open(self.output / METRICS_NAME, "a") as stream:
             stream.write(json.dumps({**metrics, "switch": reason}) + "\n")
+
+    def _trim_metrics(self) -> None:
+        """Keep only the ``metrics.jsonl`` lines of epochs up to :attr:`epoch` (none for
+        a fresh run), so that the file never mixes runs or repeats an epoch."""
+        path = self.output / METRICS_NAME
+        if not path.is_file():
+            return
+        kept = []
+        for line in path.read_text().splitlines():
+            try:
+                epoch = int(json.loads(line)["epoch"])
+            except (ValueError, KeyError, TypeError):
+                continue  # a line cut short by a kill
+            if epoch <= self.epoch:
+                kept.append(line + "\n")
+        atomic_write_bytes(path, "".join(kept).encode())

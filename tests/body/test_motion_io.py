@@ -90,6 +90,13 @@ def test_unknown_file_type_and_missing_file(tmp_path):
         load_motion(tmp_path / "junk.npz")
 
 
+@pytest.mark.parametrize("fps", [0.0, -30.0, float("nan")])
+def test_a_frame_rate_that_is_not_positive_is_refused(fps):
+    with pytest.raises(MotionError, match="fps must be a finite number > 0"):
+        load_motion("walk", fps=fps, duration=1.0)  # was silently 30 fps for 0
+    assert load_motion("walk", duration=1.0).fps == 30.0  # no fps: the library's default
+
+
 def test_cloth3d(tmp_path):
     from scipy.io import savemat
 

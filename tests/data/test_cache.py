@@ -50,20 +50,46 @@ def test_truncated_and_missing_files_are_named(cache: Path, tmp_path: Path) -> N
     sequence.write_bytes(sequence.read_bytes()[:200])
     problems = verify_cache(copy)
     assert len(problems) == 1 and sequence.name in problems[0]
-    dataset = PreparedDataset(copy, "train", window=2)
-    with pytest.raises(ValueError, match=sequence.name):
-        dataset.sequence(sequence.stem)
+    # Caught when the dataset is made (its size differs from the manifest's), by name.
+    with pytest.raises(CacheError, match=f"{sequence.name}: 200 bytes, the manifest says"):
+        PreparedDataset(copy, "train", window=2)
+    sequence.unlink()
+    with pytest.raises(CacheError, match=f"{sequence.name}: listed in the manifest but missing"):
+        PreparedDataset(copy, "train", window=2)
     with pytest.raises(CacheError, match="no split 'holdout'"):
         PreparedDataset(copy, "holdout", window=2)
     with pytest.raises(CacheError, match="no prepared cache"):
         PreparedDataset(tmp_path / "empty", "train", window=2)
 
 
+def test_a_sequence_swapped_for_another_is_caught_naming_it(cache: Path,
+                                                            tmp_path: Path) -> None:
+    import json
+    import shutil
+
+    copy = tmp_path / "copy"
+    shutil.copytree(cache, copy)
+    manifest = read_manifest(copy)
+    name, other = (n for n in manifest["splits"]["train"] if n.startswith("tube_a_body0"))
+    first, second = (copy / "sequences" / f"{n}.npz" for n in (name, other))
+    assert first.stat().st_size == second.stat().st_size  # the size check cannot see it
+    shutil.copyfile(second, first)
+    dataset = PreparedDataset(copy, "train", window=2)
+    dataset.sequence(other)
+    with pytest.raises(CacheError, match=f"{first.name}: content differs from the manifest"):
+        dataset.sequence(name)
+    # A cache written before sizes were recorded is still read, and still hash-checked.
+    del manifest["sizes"]
+    (copy / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(CacheError, match=f"{first.name}: content differs"):
+        PreparedDataset(copy, "train", window=2).batch([(name, np.array([0]))])
+
+
 def test_pairs_carry_the_cached_body_weights(cache: Path, tmp_path: Path) -> None:
     import shutil
     from dataclasses import replace
 
-    from gnngarment.data.cache import read_garment, write_garment
+    from gnngarment.data.cache import read_garment, write_garment, write_manifest
 
     dataset = PreparedDataset(cache, "train", window=2)
     name = dataset.sequence_names[0]
@@ -74,8 +100,14 @@ def test_pairs_carry_the_cached_body_weights(cache: Path, tmp_path: Path) -> Non
 
     copy = tmp_path / "copy"
     shutil.copytree(cache, copy)
-    write_garment(copy, replace(record, body_weights=None))   # a cache from before them
+    manifest = read_manifest(copy)
+
+    def rewrite(garment_record) -> None:  # and commit it: the manifest lists its hash
+        write_garment(copy, garment_record)
+        write_manifest(copy, manifest["splits"], manifest["sequences"])
+
+    rewrite(replace(record, body_weights=None))   # a cache from before them
     assert PreparedDataset(copy, "train", window=2).garment_of(name).pair.body_weights is None
-    write_garment(copy, replace(record, body_weights=record.body_weights[:-1]))
+    rewrite(replace(record, body_weights=record.body_weights[:-1]))
     with pytest.raises(CacheError, match="body_weights has shape"):
         PreparedDataset(copy, "train", window=2).garment_of(name)

@@ -20,6 +20,7 @@ from omegaconf import OmegaConf
 from data_prep.build import (
     _known_failure,
     _left_out,
+    _sequence_done,
     build_dataset,
     left_the_body,
     plan_dataset,
@@ -61,6 +62,23 @@ def test_recorded_failure_is_tied_to_its_inputs(tmp_path: Path) -> None:
     assert _known_failure(tmp_path, "other", "hash-a") is None
     (tmp_path / "sequences" / "truncated.failed").write_text('{"inputs_ha')
     assert _known_failure(tmp_path, "truncated", "hash-a") is None
+
+
+def test_a_truncated_sequence_is_rebuilt_not_counted_as_built(tmp_path: Path) -> None:
+    from gnngarment.geometry.files import save_npz_atomic
+
+    path = tmp_path / "sequences" / "skirt000_body00_walk00.npz"
+    save_npz_atomic(path, {"positions": np.zeros((4, 50, 3), np.float32)})
+    (path.parent / "skirt000_body00_walk00.hash").write_text("hash-a")
+    assert _sequence_done(tmp_path, "skirt000_body00_walk00", "hash-a")
+    assert not _sequence_done(tmp_path, "skirt000_body00_walk00", "hash-b")  # inputs changed
+    whole = path.read_bytes()
+    path.write_bytes(whole[:len(whole) // 2])                     # cut short
+    assert not _sequence_done(tmp_path, "skirt000_body00_walk00", "hash-a")
+    damaged = bytearray(whole)
+    damaged[len(whole) // 2] ^= 0xFF                              # one byte of its data
+    path.write_bytes(bytes(damaged))
+    assert not _sequence_done(tmp_path, "skirt000_body00_walk00", "hash-a")
 
 
 def down(metres: float) -> np.ndarray:

@@ -7,7 +7,7 @@ import pytest
 import trimesh
 
 from gnngarment.geometry.errors import MeshError
-from gnngarment.geometry.mesh_io import load_mesh
+from gnngarment.geometry.mesh_io import load_mesh, load_textured_mesh
 from tests.meshes import interleave, random_disk
 
 
@@ -57,3 +57,48 @@ def test_missing_unknown_and_broken_files_name_the_file(tmp_path: Path) -> None:
         "property float z\nend_header\n0 0 0\n1 1 1\n")
     with pytest.raises(MeshError, match="points.ply"):
         load_mesh(tmp_path / "points.ply")
+
+
+def test_obj_texture_coordinates_are_kept_per_corner_and_fan_split(tmp_path: Path) -> None:
+    # A quad and a triangle sharing the edge 2–3, cut there in UV space (a seam): vertex 3
+    # has vt 3 in the quad and vt 5 in the triangle. Relative (negative) indices too.
+    path = tmp_path / "seam.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 1 0\n"
+                    "vt 0 0\nvt 0.5 0\nvt 0.5 1\nvt 0 1\nvt 0.6 1\nvt 0.6 0 0\n"
+                    "f 1/1 2/2 3/3 4/4\nf -4/-1 -2/-1 -3/-2\n")
+    pos, faces, uv, uv_faces = load_textured_mesh(path)
+    assert pos.shape == (5, 3)  # the v lines, nothing split or merged
+    assert faces.tolist() == [[0, 1, 2], [0, 2, 3], [1, 3, 2]]
+    assert uv_faces.tolist() == [[0, 1, 2], [0, 2, 3], [5, 5, 4]]
+    np.testing.assert_array_equal(uv[[2, 4]], [[0.5, 1.0], [0.6, 1.0]])
+    assert load_mesh(path)[1].tolist() == faces.tolist()  # the 2-tuple reader agrees
+
+
+def test_obj_uvs_are_dropped_when_a_corner_has_none_and_bad_vt_indices_fail(
+        tmp_path: Path) -> None:
+    path = tmp_path / "partial.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                    "f 1/1 2/2 3/3\nf 2 4 3\n")
+    mesh = load_textured_mesh(path)
+    assert mesh.uv is None and mesh.uv_faces is None and len(mesh.faces) == 2
+    (tmp_path / "bad.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/3\n")
+    with pytest.raises(MeshError, match=r"bad.obj: faces name texture coordinates \(vt\) 1..3"):
+        load_textured_mesh(tmp_path / "bad.obj")
+    (tmp_path / "plain.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    assert load_textured_mesh(tmp_path / "plain.obj").uv is None
+
+
+def test_glb_uvs_come_back_per_vertex_in_obj_convention(tmp_path: Path) -> None:
+    pos, faces = random_disk(30, seed=3)
+    uv = np.random.default_rng(0).uniform(size=(len(pos), 2))
+    mesh = trimesh.Trimesh(pos, faces, process=False,
+                           visual=trimesh.visual.TextureVisuals(uv=uv))
+    path = tmp_path / "textured.glb"
+    mesh.export(path)
+    loaded = load_textured_mesh(path)
+    np.testing.assert_allclose(loaded.pos, pos, atol=1e-6)
+    np.testing.assert_allclose(loaded.uv, uv, atol=1e-6)  # v up, as given to trimesh
+    np.testing.assert_array_equal(loaded.uv_faces, loaded.faces)
+    plain = tmp_path / "plain.ply"
+    trimesh.Trimesh(pos, faces, process=False).export(plain)
+    assert load_textured_mesh(plain).uv is None

@@ -98,3 +98,19 @@ def synthetic_animation(frames: int = 6, rings: int = 8, sections: int = 20,
         blend_shapes=blend, joint_transforms=transforms,
         rest_joints=REST_JOINTS.astype(np.float32), body_vertices=body,
         body_faces=body_faces, fps=fps, seconds={})
+
+
+def tube_uv(rings: int = 8, sections: int = 20) -> tuple[np.ndarray, np.ndarray]:
+    """A cylindrical unwrap of :func:`rest_garment`'s tube with one seam: ``uv
+    (rings · (sections + 1), 2)``, ``u = s / sections``, ``v = r / (rings − 1)``, and
+    per-corner ``uv_faces (F, 3)`` in the tube's face order. The column ``s = 0`` is
+    used with ``u = 0`` on one side and ``u = 1`` on the other: ``rings`` seam vertices."""
+    row = sections + 1
+    s, r = np.meshgrid(np.arange(row), np.arange(rings))
+    uv = np.stack([s.ravel() / sections, r.ravel() / (rings - 1)], axis=1)
+    uv_faces = []
+    for ring in range(rings - 1):
+        for section in range(sections):
+            a, b = ring * row + section, ring * row + section + 1  # b: no wrap, u may be 1
+            uv_faces += [[a, b, b + row], [a, b + row, a + row]]
+    return uv, np.array(uv_faces, dtype=np.int64)

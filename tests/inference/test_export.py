@@ -8,9 +8,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gnngarment.geometry.mesh_io import read_obj
-from gnngarment.inference.export import export_animation, read_point_cache, read_point_cache_header
-from tests.inference.animations import synthetic_animation
+from gnngarment.geometry.mesh_io import read_obj, read_textured_obj
+from gnngarment.inference.export import (
+    GLTF_FROM_WORLD,
+    evaluate_mesh_node,
+    export_animation,
+    read_glb,
+    read_point_cache,
+    read_point_cache_header,
+)
+from gnngarment.inference.export.gltf_reader import keyframe_times
+from tests.inference.animations import synthetic_animation, tube_uv
 
 
 @pytest.fixture(scope="module")
@@ -29,18 +37,19 @@ def test_everything_lands_in_one_documented_layout(animation, tmp_path: Path) ->
         "gif": "skirt.gif", "manifest": "skirt_export.json"}
     assert set(stages) == {"glb", "pc2", "obj", "gif"}
     names = sorted(p.name for p in (out / "skirt_obj").iterdir())
-    assert names == [f"body_{t:04d}.obj" for t in range(1, 5)] + [
-        f"garment_{t:04d}.obj" for t in range(1, 5)]
-    np.testing.assert_allclose(read_obj(out / "skirt_obj" / "garment_0003.obj")[0],
+    assert names == [f"body_{t:04d}.obj" for t in range(4)] + [
+        f"garment_{t:04d}.obj" for t in range(4)]
+    np.testing.assert_allclose(read_obj(out / "skirt_obj" / "garment_0002.obj")[0],
                                animation.posed[2], atol=1e-6)
     np.testing.assert_array_equal(read_point_cache(paths["pc2"]), animation.posed)
-    assert read_point_cache_header(paths["pc2"]).start_frame == 1.0
+    assert read_point_cache_header(paths["pc2"]).start_frame == 0.0
     rest, faces = read_obj(paths["rest_obj"])
     np.testing.assert_allclose(rest, animation.rest_pos, atol=1e-6)
     np.testing.assert_array_equal(faces, animation.faces)
     assert read_point_cache(paths["body_pc2"]).shape == animation.body_vertices.shape
     manifest = json.loads(paths["manifest"].read_text())
-    assert manifest["frames"] == 4 and manifest["first_frame"] == 1
+    assert manifest["frames"] == 4 and manifest["first_frame"] == 0
+    assert manifest["glb"]["start_time_s"] == 0.0 and manifest["uv"] is False
     assert manifest["glb"]["max_error_mm"] < 1e-3
     assert manifest["files"]["gif"] == "skirt.gif"
     assert not [p for p in out.rglob(".*")]  # no temporary files left behind
@@ -48,10 +57,10 @@ def test_everything_lands_in_one_documented_layout(animation, tmp_path: Path) ->
 
 def test_subset_without_body(animation, tmp_path: Path) -> None:
     paths = export_animation(animation, tmp_path, "g", formats=("pc2", "obj"),
-                             include_body=False, first_frame=0)
+                             include_body=False, first_frame=1)
     assert set(paths) == {"pc2", "rest_obj", "obj", "manifest"}
-    assert sorted(p.name for p in paths["obj"].iterdir())[0] == "garment_0000.obj"
-    assert read_point_cache_header(paths["pc2"]).start_frame == 0.0
+    assert sorted(p.name for p in paths["obj"].iterdir())[0] == "garment_0001.obj"
+    assert read_point_cache_header(paths["pc2"]).start_frame == 1.0
 
 
 @pytest.mark.parametrize(("kwargs", "message"), [
@@ -59,9 +68,68 @@ def test_subset_without_body(animation, tmp_path: Path) -> None:
     ({"formats": ()}, "formats must be"),
     ({"name": "../up"}, "plain file stem"),
     ({"name": ""}, "plain file stem"),
+    ({"first_frame": -1}, "first_frame"),
 ])
 def test_bad_arguments(animation, tmp_path: Path, kwargs, message) -> None:
     arguments = {"name": "g", **kwargs}
     with pytest.raises(ValueError, match=message):
         export_animation(animation, tmp_path / "out", **arguments)
     assert not (tmp_path / "out").exists()
+
+
+def glb_blender_frames(times: np.ndarray, fps: float) -> np.ndarray:
+    """Scene frames Blender's glTF importer keys animation times at: ``time × fps``
+    (io_scene_gltf2 ``blender/imp/animation_node.py``, ``animation_weight.py``:
+    ``key[0] * fps``; no offset, the scene's frame range is left alone)."""
+    return times * fps
+
+
+def mesh_cache_sample(scene_frame: int, frame_start: int) -> int:
+    """The PC2 sample Blender's Mesh Cache modifier shows (Time Mode Frame, Play Mode
+    Scene, Frame Scale 1; ``MOD_meshcache.cc``): ``scene_frame − frame_start``; the
+    header's start frame is ignored."""
+    return scene_frame - frame_start
+
+
+@pytest.mark.parametrize("first_frame", [0, 5])
+def test_glb_obj_and_pc2_show_the_same_frame_at_the_same_frame_number(
+        animation, tmp_path: Path, first_frame: int) -> None:
+    paths = export_animation(animation, tmp_path, "g", formats=("obj", "pc2", "glb"),
+                             include_body=False, first_frame=first_frame)
+    count = len(animation.posed)
+    numbers = sorted(int(p.stem.split("_")[1]) for p in paths["obj"].glob("garment_*.obj"))
+    glb = read_glb(paths["glb"])
+    times = keyframe_times(glb)
+    header = read_point_cache_header(paths["pc2"])
+    # Every format starts at first_frame and steps one frame per sample.
+    assert numbers == list(range(first_frame, first_frame + count))
+    assert (header.start_frame, header.sample_rate) == (first_frame, 1.0)
+    np.testing.assert_allclose(glb_blender_frames(times, animation.fps),
+                               np.arange(first_frame, first_frame + count), atol=1e-4)
+    # ... and at scene frame first_frame + k all three show posed[k] (the docs' import
+    # steps: Mesh Cache Frame Start = the manifest's first_frame).
+    cache = read_point_cache(paths["pc2"])
+    decoded = evaluate_mesh_node(glb, "g", times) @ GLTF_FROM_WORLD  # back to Z up
+    for k in range(count):
+        frame = first_frame + k
+        obj = read_obj(paths["obj"] / f"garment_{frame:04d}.obj")[0]
+        np.testing.assert_allclose(obj, animation.posed[k], atol=1e-6)
+        np.testing.assert_array_equal(cache[mesh_cache_sample(frame, first_frame)],
+                                      animation.posed[k])
+        np.testing.assert_allclose(decoded[k], animation.posed[k], atol=1e-6)
+
+
+def test_input_uvs_reach_the_garment_objs_and_the_glb(tmp_path: Path) -> None:
+    animation = synthetic_animation(frames=3)
+    animation.uv, animation.uv_faces = tube_uv()
+    paths = export_animation(animation, tmp_path, "g", formats=("obj", "pc2", "glb"))
+    for path in [paths["rest_obj"], *sorted(paths["obj"].glob("garment_*.obj"))]:
+        mesh = read_textured_obj(path)
+        assert len(mesh.pos) == len(animation.rest_pos)
+        np.testing.assert_array_equal(mesh.uv_faces, animation.uv_faces)
+        np.testing.assert_allclose(mesh.uv, animation.uv, atol=1e-6)
+    assert read_textured_obj(paths["obj"] / "body_0000.obj").uv is None
+    primitive = read_glb(paths["glb"]).document["meshes"][0]["primitives"][0]
+    assert "TEXCOORD_0" in primitive["attributes"]
+    manifest = json.loads(paths["manifest"].read_text())
+    assert manifest["uv"] is True and manifest["glb"]["seam_vertices"] == 8

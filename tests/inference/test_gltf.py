@@ -13,7 +13,7 @@ import pytest
 
 from gnngarment.inference.export.gltf import GLTF_FROM_WORLD, write_glb
 from gnngarment.inference.export.gltf_reader import evaluate_mesh_node, keyframe_times, read_glb
-from tests.inference.animations import synthetic_animation
+from tests.inference.animations import synthetic_animation, tube_uv
 
 ROOT = Path(__file__).resolve().parents[2]
 VALIDATOR_SCRIPT = Path(__file__).with_name("validate_gltf.mjs")
@@ -139,3 +139,52 @@ def test_reader_rejects_non_glb_files(tmp_path: Path) -> None:
         read_glb(path)
     with pytest.raises(ValueError, match="cannot read"):
         read_glb(tmp_path / "missing.glb")
+
+
+def test_input_uvs_become_texcoord_0_with_seams_split(tmp_path: Path) -> None:
+    animation = synthetic_animation(frames=5)
+    animation.uv, animation.uv_faces = tube_uv()
+    count = len(animation.rest_pos)
+    path = tmp_path / "skirt.glb"
+    result = write_glb(animation, path, name="skirt")
+    report = khronos_report(path)
+    assert report["issues"]["numErrors"] == 0, report["issues"]["messages"]
+    assert report["issues"]["numWarnings"] == 0, report["issues"]["messages"]
+    # The one info: no texture of the (untextured) material reads TEXCOORD_0 yet.
+    assert [(m["code"], m["pointer"]) for m in report["issues"]["messages"]] == [
+        ("UNUSED_OBJECT", "/meshes/0/primitives/0/attributes/TEXCOORD_0")]
+
+    glb = read_glb(path)
+    mesh = glb.document["meshes"][0]
+    primitive = mesh["primitives"][0]
+    # glb vertex i < N is input vertex i; each seam duplicate names its input vertex.
+    sources = np.concatenate([np.arange(count), mesh["extras"]["seamSources"]])
+    assert result.seam_vertices == len(sources) - count == 8  # one per ring of the tube
+    glb_faces = glb.accessor(primitive["indices"]).reshape(-1, 3).astype(np.int64)
+    np.testing.assert_array_equal(sources[glb_faces], animation.faces)  # un-split = input
+    texcoord = glb.accessor(primitive["attributes"]["TEXCOORD_0"]).astype(np.float64)
+    assert texcoord.shape == (len(sources), 2)
+    corner_uv = texcoord[glb_faces] * [1.0, -1.0] + [0.0, 1.0]  # back to OBJ's v up
+    np.testing.assert_allclose(corner_uv, animation.uv[animation.uv_faces], atol=1e-7)
+
+    # What a viewer shows reproduces the prediction at every input vertex and duplicate.
+    decoded = evaluate_mesh_node(glb, "skirt")
+    expected = animation.posed.astype(np.float64) @ GLTF_FROM_WORLD.T
+    np.testing.assert_allclose(decoded, expected[:, sources], atol=1e-6)
+    assert result.max_error < 1e-6
+    normals = glb.accessor(primitive["attributes"]["NORMAL"])
+    np.testing.assert_array_equal(normals, normals[sources])  # seams stay smooth
+
+
+def test_first_frame_sets_the_time_blender_maps_to_that_frame(animation, tmp_path: Path
+                                                              ) -> None:
+    result = write_glb(animation, tmp_path / "g.glb", first_frame=3)
+    times = keyframe_times(read_glb(result.path))
+    # Blender's glTF importer keys scene frame `time × fps` (io_scene_gltf2,
+    # blender/imp/animation_node.py and animation_weight.py: `key[0] * fps`).
+    np.testing.assert_allclose(times * animation.fps, 3 + np.arange(len(animation.posed)),
+                               atol=1e-4)
+    assert result.start_time == pytest.approx(3 / animation.fps)
+    assert result.max_error < 1e-6
+    with pytest.raises(ValueError, match="first_frame"):
+        write_glb(animation, tmp_path / "h.glb", first_frame=-1)

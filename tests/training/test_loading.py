@@ -30,6 +30,13 @@ def test_model_file_training_overrides_and_command_line(tmp_path: Path) -> None:
     ("model_config: absent.yaml\n", [], "absent.yaml"),
     ("epochs: 3\n", ["modle.levels=1"], "modle"),
     ("model: {pooling: mean}\n", [], "pooling"),
+    ("epochs: 0\n", [], "bad.yaml: key 'epochs': must be >= 1, got 0"),
+    ("learning_rate: .nan\n", [], "key 'learning_rate': must be a finite number > 0"),
+    ("epochs: 3\n", ["pairs_per_batch=0"], "key 'pairs_per_batch': must be >= 1"),
+    ("seed: -1\n", [], "key 'seed': must be >= 0"),
+    ("losses: {collision: -1.5}\n", [], "key 'losses.collision'"),
+    ("stages: {max_epochs: [4, 1]}\n", [], "key 'stages.max_epochs': expected 3"),
+    ("stages: {collision_window: 0}\n", [], "key 'stages.collision_window'"),
 ])
 def test_bad_configs_are_named(tmp_path: Path, text: str, overrides, message: str) -> None:
     path = tmp_path / "bad.yaml"

@@ -11,7 +11,7 @@ import torch
 from gnngarment.data import PreparedDataset
 from gnngarment.training.checkpoint import load_checkpoint, load_model, release_checkpoint
 from gnngarment.training.config import StageConfig, TrainingConfig
-from gnngarment.training.trainer import Trainer, TrainingStep
+from gnngarment.training.trainer import RunFolderError, Trainer, TrainingStep
 from tests.model.pairs import tiny_config
 from tests.synthetic_cache import build_synthetic_cache
 
@@ -73,6 +73,21 @@ def test_resume_continues_exactly(cache: Path, tmp_path: Path) -> None:
                             resumed.model.state_dict().values(), strict=True):
         assert torch.equal(a, b), name
     assert resumed.schedule.state_dict() == straight.schedule.state_dict()
+
+
+def test_a_run_folder_holds_one_run_and_its_metrics(cache: Path, tmp_path: Path) -> None:
+    config = config_for(cache, tmp_path / "run", epochs=2)
+    make_trainer(config, validation=False).fit()
+    with pytest.raises(RunFolderError, match="last.pt: the output folder holds another run"):
+        make_trainer(config, validation=False).fit()  # would have appended to its metrics
+    metrics = tmp_path / "run" / "metrics.jsonl"
+    # A kill after an epoch's log line but before its checkpoint, then one cut short.
+    lines = metrics.read_text().splitlines()
+    metrics.write_text("\n".join([*lines, lines[-1].replace('"epoch": 2', '"epoch": 3'),
+                                  '{"epo']) + "\n")
+    config.epochs = 3
+    make_trainer(config, validation=False).fit(resume=True)
+    assert [json.loads(line)["epoch"] for line in metrics.read_text().splitlines()] == [1, 2, 3]
 
 
 def test_checkpoints_are_safe_and_bad_ones_are_named(cache: Path, tmp_path: Path) -> None:

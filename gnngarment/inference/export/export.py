@@ -8,18 +8,21 @@ Layout of ``out_dir`` for ``name="skirt"`` (each file written atomically)::
     skirt_rest.obj         the garment rest mesh the .pc2 applies to (same vertex order)
     skirt_body.pc2         body point cache            (include_body)
     skirt_body.obj         body base mesh, first frame (include_body)
-    skirt_obj/garment_0001.obj …   one OBJ per frame   (body_0001.obj … with include_body)
+    skirt_obj/garment_0000.obj …   one OBJ per frame   (body_0000.obj … with include_body)
     skirt.gif              preview
     skirt_export.json      manifest: frames, fps, numbering, files, glb error
 
-Frames are numbered from ``first_frame`` (1, Blender's default first frame) in OBJ names
-and the ``.pc2`` header; ``Animation.posed[0]`` is frame 1.
+``Animation.posed[0]`` is frame ``first_frame`` (0) in every format: the OBJ names, the
+``.pc2`` header and the glb, whose frame ``k`` is keyed at ``(first_frame + k) / fps`` s
+(Blender's glTF importer puts time ``t`` at scene frame ``t · fps``). The garment OBJs
+(sequence and rest mesh) and the glb carry the input's UVs (``Animation.uv``).
 """
 
 from __future__ import annotations
 
 import json
 from collections.abc import Callable
+from numbers import Integral
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -43,7 +46,7 @@ Progress = Callable[[str, int, int], None]
 def export_animation(animation: Animation, out_dir: str | Path, name: str,
                      formats: tuple[str, ...] | list[str] = DEFAULT_FORMATS,
                      include_body: bool = True, progress: Progress | None = None, *,
-                     first_frame: int = 1, max_influences: int = 4,
+                     first_frame: int = 0, max_influences: int = 4,
                      morph_interpolation: str = "LINEAR", preview_size: int = 288,
                      preview_max_frames: int = 48) -> dict[str, Path]:
     """Export an animation in the requested formats.
@@ -57,7 +60,9 @@ def export_animation(animation: Animation, out_dir: str | Path, name: str,
         include_body: also export the posed body (OBJ sequence, point cache, glb mesh,
             preview).
         progress: called as ``progress(stage, done, total)``.
-        first_frame: number of the first frame in OBJ names and the ``.pc2`` header.
+        first_frame: frame number of ``posed[0]`` (≥ 0) in OBJ names, the ``.pc2``
+            header and the glb (keyed at ``first_frame / fps`` s, Blender frame
+            ``first_frame``). 0 keeps the glb starting at time 0, as engines expect.
         max_influences: joints per vertex in the glb skin (4, or up to 8).
         morph_interpolation: glb morph weights, ``"LINEAR"`` or ``"STEP"``.
         preview_size: preview height/width in pixels.
@@ -76,6 +81,8 @@ def export_animation(animation: Animation, out_dir: str | Path, name: str,
     if not name or not all(c.isalnum() or c in "-_." for c in name) or name.startswith("."):
         raise ValueError(f"name must be a plain file stem (letters, digits, - _ .), "
                          f"got {name!r}")
+    if not isinstance(first_frame, Integral) or first_frame < 0:
+        raise ValueError(f"first_frame must be an integer ≥ 0, got {first_frame!r}")
     check_animation(animation, body=include_body)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -85,7 +92,9 @@ def export_animation(animation: Animation, out_dir: str | Path, name: str,
         "name": name, "frames": frames, "fps": float(animation.fps),
         "first_frame": first_frame, "garment_vertices": int(animation.posed.shape[1]),
         "units": "metres", "up_axis": "Z (OBJ, PC2); Y (glb, per the glTF spec)",
+        "uv": animation.uv is not None,
     }
+    uv = {"uv": animation.uv, "uv_faces": animation.uv_faces}
 
     def report(stage: str) -> Callable[[int, int], None] | None:
         if progress is None:
@@ -95,21 +104,24 @@ def export_animation(animation: Animation, out_dir: str | Path, name: str,
     if "glb" in formats:
         result = write_glb(animation, out / f"{name}.glb", name=name,
                            max_influences=max_influences,
-                           morph_interpolation=morph_interpolation, include_body=include_body)
+                           morph_interpolation=morph_interpolation, include_body=include_body,
+                           first_frame=first_frame)
         paths["glb"] = result.path
         manifest["glb"] = {
             "max_influences": max_influences, "morph_interpolation": morph_interpolation,
             "max_error_mm": 1000 * result.max_error, "mean_error_mm": 1000 * result.mean_error,
             "skin_only_max_error_mm": 1000 * result.skin_only_max_error,
             "skin_only_mean_error_mm": 1000 * result.skin_only_mean_error,
-            "ill_conditioned": result.ill_conditioned, "bytes": result.num_bytes}
+            "ill_conditioned": result.ill_conditioned, "bytes": result.num_bytes,
+            "start_time_s": result.start_time, "seam_vertices": result.seam_vertices}
         if progress is not None:
             progress("glb", 1, 1)
     if "pc2" in formats:
         header = {"start_frame": float(first_frame), "sample_rate": 1.0}
         paths["pc2"] = write_point_cache(out / f"{name}.pc2", animation.posed, **header)
         paths["rest_obj"] = write_obj(out / f"{name}_rest.obj", animation.rest_pos,
-                                      animation.faces, header=f"{name} rest mesh (metres, Z up)")
+                                      animation.faces, header=f"{name} rest mesh (metres, Z up)",
+                                      **uv)
         if include_body:
             paths["body_pc2"] = write_point_cache(out / f"{name}_body.pc2",
                                                   animation.body_vertices, **header)
@@ -121,7 +133,7 @@ def export_animation(animation: Animation, out_dir: str | Path, name: str,
     if "obj" in formats:
         folder = out / f"{name}_obj"
         write_obj_sequence(folder, animation.posed, animation.faces, "garment", first_frame,
-                           report("obj"))
+                           report("obj"), **uv)
         if include_body:
             write_obj_sequence(folder, animation.body_vertices, animation.body_faces, "body",
                                first_frame)

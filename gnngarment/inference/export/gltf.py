@@ -17,11 +17,20 @@ What is written (see ``docs/export.md``):
 * **Axes**: glTF is Y up with the asset facing +Z; the library's world is Z up facing −Y,
   so every position and transform is rotated by :data:`GLTF_FROM_WORLD` (−90° about X).
   Importers (Blender's included) rotate back to Z up.
+* **UVs** (``Animation.uv``): ``TEXCOORD_0`` with ``v`` flipped (glTF's origin is the
+  image's top-left). glTF has one UV per vertex, so vertices on a UV seam are duplicated
+  in the glb (:func:`~gnngarment.geometry.texture_coordinates.split_uv_seams`): vertex
+  ``i < N`` is input vertex ``i``, the duplicates follow and ``mesh.extras.seamSources``
+  names the input vertex of each.
+* **Time**: frame ``k`` is keyed at ``(first_frame + k) / fps`` s; Blender's importer
+  puts time ``t`` at scene frame ``t · fps``, so the glb's frames carry the numbers of
+  the OBJ files and the ``.pc2`` header.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from numbers import Integral
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -29,6 +38,7 @@ import numpy as np
 
 from gnngarment.body.skeleton import JOINT_NAMES
 from gnngarment.geometry.normals import vertex_normals
+from gnngarment.geometry.texture_coordinates import SeamSplit, split_uv_seams
 from gnngarment.inference.export.atomic import atomic_write_bytes
 from gnngarment.inference.export.gltf_reader import evaluate_mesh_node, read_glb
 from gnngarment.inference.export.skeleton_animation import (
@@ -76,6 +86,9 @@ class GlbExport:
         max_residual: largest morph target displacement (rest frame).
         ill_conditioned: (frame, vertex) pairs solved in the least-squares sense.
         num_bytes: file size.
+        seam_vertices: vertices duplicated along UV seams (0 without UVs); the glb
+            garment has ``N + seam_vertices`` vertices.
+        start_time: seconds of the first keyframe, ``first_frame / fps``.
     """
 
     path: Path
@@ -88,12 +101,14 @@ class GlbExport:
     max_residual: float
     ill_conditioned: int
     num_bytes: int
+    seam_vertices: int = 0
+    start_time: float = 0.0
 
 
 def write_glb(animation: Animation, path: str | Path, *, name: str = "garment",
               max_influences: int = 4, reference: str | int = "mean",
               morph_interpolation: str = "LINEAR", include_body: bool = False,
-              normals: bool = True, verify: bool = True) -> GlbExport:
+              normals: bool = True, verify: bool = True, first_frame: int = 0) -> GlbExport:
     """Write the animated garment as a skinned, morph-animated glTF binary, atomically.
 
     Args:
@@ -113,6 +128,13 @@ def write_glb(animation: Animation, path: str | Path, *, name: str = "garment",
         normals: write garment normals and per-frame normal deltas (smooth shading
             that follows the cloth); without them viewers shade flat.
         verify: decode the written file and measure its error (``GlbExport.max_error``).
+        first_frame: frame number of ``posed[0]``: frame ``k`` is keyed at
+            ``(first_frame + k) / fps`` seconds, which Blender's importer places at scene
+            frame ``first_frame + k`` (0: the animation starts at time 0, as engines
+            expect).
+
+    With ``Animation.uv`` the garment carries ``TEXCOORD_0``, its seam vertices split
+    (positions, skin, morph targets and normals copied to each duplicate).
 
     Returns:
         The export summary.
@@ -128,6 +150,9 @@ def write_glb(animation: Animation, path: str | Path, *, name: str = "garment",
                          f"got {morph_interpolation!r}")
     if not 1 <= max_influences <= 8:
         raise ValueError(f"max_influences must be in 1..8, got {max_influences}")
+    if not isinstance(first_frame, Integral) or first_frame < 0:
+        raise ValueError(f"first_frame must be an integer ≥ 0 (glTF times are ≥ 0), "
+                         f"got {first_frame!r}")
     path = Path(path)
     frames = len(animation.posed)
     convert = GLTF_FROM_WORLD
@@ -149,14 +174,19 @@ def write_glb(animation: Animation, path: str | Path, *, name: str = "garment",
 
     builder = _Builder()
     faces = np.asarray(animation.faces, dtype=np.int64)
+    split = None
+    if animation.uv is not None:
+        split = split_uv_seams(faces, animation.uv, animation.uv_faces, len(rest32))
     garment_primitive = _garment_primitive(builder, rest32, faces, residuals.offsets, skin,
-                                           normals)
+                                           normals, split)
     nodes, joint_nodes = _skeleton_nodes(tracks)
     garment_node = len(nodes)
     targets = [f"frame_{t:04d}" for t in range(frames)]
+    extras: dict = {"targetNames": targets}
+    if split is not None and split.seam_vertices:
+        extras["seamSources"] = split.source[len(rest32):].tolist()
     meshes = [pygltflib.Mesh(name=name, primitives=[garment_primitive],
-                             weights=_one_hot(frames, 0).tolist(),
-                             extras={"targetNames": targets})]
+                             weights=_one_hot(frames, 0).tolist(), extras=extras)]
     nodes.append(pygltflib.Node(name=name, mesh=0, skin=0))
     materials = [_material(f"{name}_material", GARMENT_COLOUR, double_sided=True)]
     scene_nodes = [0, garment_node]
@@ -173,7 +203,7 @@ def write_glb(animation: Animation, path: str | Path, *, name: str = "garment",
         nodes.append(pygltflib.Node(name="body", mesh=1))
         scene_nodes.append(body_node)
 
-    times = np.arange(frames, dtype=np.float64) / float(animation.fps)
+    times = (first_frame + np.arange(frames, dtype=np.float64)) / float(animation.fps)
     animation_record = _animation(builder, name, times, tracks, joint_nodes,
                                   [(garment_node, morph_interpolation)] +
                                   ([(body_node, morph_interpolation)] if include_body else []),
@@ -196,14 +226,17 @@ def write_glb(animation: Animation, path: str | Path, *, name: str = "garment",
     if verify:
         decoded = evaluate_mesh_node(read_glb(path), garment_node,
                                      builder.arrays["times"])
-        distance = np.linalg.norm(decoded - posed, axis=-1)
+        expected = posed if split is None else posed[:, split.source]
+        distance = np.linalg.norm(decoded - expected, axis=-1)
         max_error, mean_error = float(distance.max()), float(distance.mean())
     return GlbExport(
         path=path, num_frames=frames, max_influences=max_influences, max_error=max_error,
         mean_error=mean_error, skin_only_max_error=float(skin_only.max()),
         skin_only_mean_error=float(skin_only.mean()),
         max_residual=float(np.linalg.norm(residuals.offsets, axis=-1).max()),
-        ill_conditioned=residuals.ill_conditioned, num_bytes=len(data))
+        ill_conditioned=residuals.ill_conditioned, num_bytes=len(data),
+        seam_vertices=0 if split is None else split.seam_vertices,
+        start_time=float(builder.arrays["times"][0]))
 
 
 # --------------------------------------------------------------------------- pieces
@@ -248,21 +281,30 @@ def _unit_normals(pos: np.ndarray, faces: np.ndarray, fallback: np.ndarray | Non
 
 
 def _garment_primitive(builder: _Builder, rest: np.ndarray, faces: np.ndarray,
-                       offsets: np.ndarray, skin: StaticSkin, normals: bool):
+                       offsets: np.ndarray, skin: StaticSkin, normals: bool,
+                       split: SeamSplit | None = None):
+    """The skinned, morph-targeted garment; with ``split``, over the seam-split vertices
+    (normals are computed on the unsplit mesh, so seams stay smooth)."""
     import pygltflib
 
+    source = np.arange(len(rest)) if split is None else split.source
+    count = len(source)
     attributes = pygltflib.Attributes(
-        POSITION=builder.add(rest.astype(np.float32), "VEC3", bounds=True,
+        POSITION=builder.add(rest[source].astype(np.float32), "VEC3", bounds=True,
                              target=ARRAY_BUFFER))
     base_normals = None
     if normals:
         base_normals = _unit_normals(rest, faces).astype(np.float32)
-        attributes.NORMAL = builder.add(base_normals, "VEC3", target=ARRAY_BUFFER)
+        attributes.NORMAL = builder.add(base_normals[source], "VEC3", target=ARRAY_BUFFER)
+    if split is not None:
+        flipped = np.stack([split.uv[:, 0], 1.0 - split.uv[:, 1]], axis=1)  # glTF v is down
+        attributes.TEXCOORD_0 = builder.add(flipped.astype(np.float32), "VEC2",
+                                            target=ARRAY_BUFFER)
     padded = -(-skin.joints.shape[1] // 4) * 4
-    joints = np.zeros((len(rest), padded), dtype=np.uint8)
-    weights = np.zeros((len(rest), padded), dtype=np.float32)
-    joints[:, :skin.joints.shape[1]] = skin.joints
-    weights[:, :skin.weights.shape[1]] = skin.weights
+    joints = np.zeros((count, padded), dtype=np.uint8)
+    weights = np.zeros((count, padded), dtype=np.float32)
+    joints[:, :skin.joints.shape[1]] = skin.joints[source]
+    weights[:, :skin.weights.shape[1]] = skin.weights[source]
     for n in range(padded // 4):
         setattr(attributes, f"JOINTS_{n}", builder.add(joints[:, 4 * n:4 * n + 4], "VEC4",
                                                        target=ARRAY_BUFFER))
@@ -270,14 +312,16 @@ def _garment_primitive(builder: _Builder, rest: np.ndarray, faces: np.ndarray,
                                                         target=ARRAY_BUFFER))
     targets = []
     for offset in offsets:
-        target = {"POSITION": builder.add(offset.astype(np.float32), "VEC3", bounds=True,
-                                          target=ARRAY_BUFFER)}
+        target = {"POSITION": builder.add(offset[source].astype(np.float32), "VEC3",
+                                          bounds=True, target=ARRAY_BUFFER)}
         if base_normals is not None:
             moved = _unit_normals(rest + offset, faces, base_normals)
-            target["NORMAL"] = builder.add((moved - base_normals).astype(np.float32), "VEC3",
-                                           target=ARRAY_BUFFER)
+            target["NORMAL"] = builder.add((moved - base_normals)[source].astype(np.float32),
+                                           "VEC3", target=ARRAY_BUFFER)
         targets.append(target)
-    return pygltflib.Primitive(attributes=attributes, indices=_indices(builder, faces, len(rest)),
+    split_faces = faces if split is None else split.faces
+    return pygltflib.Primitive(attributes=attributes,
+                               indices=_indices(builder, split_faces, count),
                                targets=targets, material=0, mode=4)
 
 

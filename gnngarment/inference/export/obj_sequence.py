@@ -1,9 +1,12 @@
 """One Wavefront OBJ per frame, vertices in the input's order (Blender: "Keep Vert Order").
 
-Each file holds only ``v`` and ``f`` lines (no normals, UVs, groups or objects), so every
-importer reads the vertices back in file order and a point cache or shape key made from
-one frame lines up with any other. Coordinates are the library's world frame: metres,
-**Z up**, the body facing −Y (import with "Up: Z, Forward: Y" in Blender to keep them).
+Each file holds ``v`` and ``f`` lines and, when the input garment had texture
+coordinates, its ``vt`` lines with ``f v/vt`` corners exactly as the input indexed them
+(seams included: UVs are per face corner, so the ``v`` lines stay the input's vertices).
+No normals, groups or objects, so every importer reads the vertices back in file order
+and a point cache or shape key made from one frame lines up with any other. Coordinates
+are the library's world frame: metres, **Z up**, the body facing −Y (import with "Up: Z,
+Forward: Y" in Blender to keep them).
 """
 
 from __future__ import annotations
@@ -13,27 +16,32 @@ from pathlib import Path
 
 import numpy as np
 
+from gnngarment.geometry.texture_coordinates import check_texture_coordinates
 from gnngarment.inference.export.atomic import atomic_write_bytes
 
 #: Decimals written per coordinate: 1 µm, far below any garment detail.
 DECIMALS = 6
 
 
-def obj_text(pos: np.ndarray, faces: np.ndarray, header: str = "") -> str:
-    """The OBJ text of one mesh: optional ``# header`` lines, ``v`` lines in order, then
-    ``f`` lines (1-based).
+def obj_text(pos: np.ndarray, faces: np.ndarray, header: str = "",
+             uv: np.ndarray | None = None, uv_faces: np.ndarray | None = None) -> str:
+    """The OBJ text of one mesh: optional ``# header`` lines, ``v`` lines in order, the
+    ``vt`` lines when ``uv`` is given, then ``f`` lines (1-based; ``f v/vt`` with UVs).
 
     Shapes:
-        pos ``(N, 3)``, faces ``(F, 3)`` 0-based.
+        pos ``(N, 3)``, faces ``(F, 3)`` 0-based; uv ``(K, 2)`` (OBJ convention) and
+        uv_faces ``(F, 3)`` 0-based per-corner indices into it, or both ``None``.
     """
     comments = "".join(f"# {line}\n" for line in header.splitlines())
-    return comments + _vertex_block(np.asarray(pos)) + _face_block(np.asarray(faces))
+    return (comments + _vertex_block(np.asarray(pos))
+            + _texture_and_face_block(np.asarray(faces), uv, uv_faces))
 
 
-def write_obj(path: str | Path, pos: np.ndarray, faces: np.ndarray, header: str = "") -> Path:
+def write_obj(path: str | Path, pos: np.ndarray, faces: np.ndarray, header: str = "",
+              uv: np.ndarray | None = None, uv_faces: np.ndarray | None = None) -> Path:
     """Write one OBJ atomically (see :func:`obj_text`); the folder must exist."""
-    _check(np.asarray(pos)[None], np.asarray(faces))
-    return atomic_write_bytes(path, obj_text(pos, faces, header).encode("ascii"))
+    _check(np.asarray(pos)[None], np.asarray(faces), uv, uv_faces)
+    return atomic_write_bytes(path, obj_text(pos, faces, header, uv, uv_faces).encode("ascii"))
 
 
 def frame_path(folder: str | Path, stem: str, number: int, digits: int = 4) -> Path:
@@ -42,33 +50,37 @@ def frame_path(folder: str | Path, stem: str, number: int, digits: int = 4) -> P
 
 
 def write_obj_sequence(folder: str | Path, frames: np.ndarray, faces: np.ndarray,
-                       stem: str = "garment", first_frame: int = 1,
-                       progress: Callable[[int, int], None] | None = None) -> list[Path]:
-    """Write ``folder/<stem>_0001.obj`` … one per frame, each atomically.
+                       stem: str = "garment", first_frame: int = 0,
+                       progress: Callable[[int, int], None] | None = None,
+                       uv: np.ndarray | None = None,
+                       uv_faces: np.ndarray | None = None) -> list[Path]:
+    """Write ``folder/<stem>_0000.obj`` … one per frame, each atomically.
 
     Args:
         folder: created if missing.
         frames: ``(T, N, 3)`` positions, metres, in the order of the input mesh.
         faces: ``(F, 3)`` 0-based triangles (the same for every frame).
         stem: file name prefix.
-        first_frame: number of the first file (1 matches Blender's first frame and the
-            ``.pc2`` header written next to it).
+        first_frame: number of the first file (the frame number ``frames[0]`` has in
+            every export: the ``.pc2`` header, the glb's time × fps).
         progress: called with (frames written, total).
+        uv, uv_faces: the input's texture coordinates ``(K, 2)`` and per-corner indices
+            ``(F, 3)``, written as ``vt`` lines and ``f v/vt`` corners in every file.
 
     Returns:
         The paths, in frame order. Numbers are zero-padded to at least 4 digits (more if
         the sequence needs them), so a name sort is a frame sort.
 
     Raises:
-        ValueError: wrong shapes, non-finite positions or out-of-range faces.
+        ValueError: wrong shapes, non-finite positions or out-of-range faces (or UVs).
     """
     frames = np.asarray(frames)
     faces = np.asarray(faces)
-    _check(frames, faces)
+    _check(frames, faces, uv, uv_faces)
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     digits = max(4, len(str(first_frame + len(frames) - 1)))
-    face_block = _face_block(faces)
+    face_block = _texture_and_face_block(faces, uv, uv_faces)
     paths = []
     for t, frame in enumerate(frames):
         path = frame_path(folder, stem, first_frame + t, digits)
@@ -85,11 +97,18 @@ def _vertex_block(pos: np.ndarray) -> str:
     return (line * len(pos)) % tuple(np.asarray(pos, dtype=np.float64).ravel().tolist())
 
 
-def _face_block(faces: np.ndarray) -> str:
-    return ("f %d %d %d\n" * len(faces)) % tuple((np.asarray(faces) + 1).ravel().tolist())
+def _texture_and_face_block(faces: np.ndarray, uv: np.ndarray | None,
+                            uv_faces: np.ndarray | None) -> str:
+    if uv is None:
+        return ("f %d %d %d\n" * len(faces)) % tuple((np.asarray(faces) + 1).ravel().tolist())
+    texture = (f"vt %.{DECIMALS}f %.{DECIMALS}f\n" * len(uv)) % tuple(
+        np.asarray(uv, dtype=np.float64).ravel().tolist())
+    corners = np.stack([np.asarray(faces), np.asarray(uv_faces)], axis=-1) + 1  # (F, 3, 2)
+    return texture + ("f %d/%d %d/%d %d/%d\n" * len(faces)) % tuple(corners.ravel().tolist())
 
 
-def _check(frames: np.ndarray, faces: np.ndarray) -> None:
+def _check(frames: np.ndarray, faces: np.ndarray, uv: np.ndarray | None = None,
+           uv_faces: np.ndarray | None = None) -> None:
     if frames.ndim != 3 or frames.shape[2] != 3 or frames.shape[1] == 0:
         raise ValueError(f"frames must be (T, N, 3) with N ≥ 1, got {frames.shape}")
     if not np.isfinite(frames).all():
@@ -99,3 +118,7 @@ def _check(frames: np.ndarray, faces: np.ndarray) -> None:
     if len(faces) and (faces.min() < 0 or faces.max() >= frames.shape[1]):
         raise ValueError(f"faces index [{faces.min()}, {faces.max()}] outside "
                          f"[0, {frames.shape[1] - 1}]")
+    if (uv is None) != (uv_faces is None):
+        raise ValueError("uv and uv_faces must be given together (or both None)")
+    if uv is not None:
+        check_texture_coordinates(uv, uv_faces, len(faces))

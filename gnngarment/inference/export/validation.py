@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from gnngarment.body.skeleton import NUM_JOINTS
+from gnngarment.geometry.texture_coordinates import check_texture_coordinates
 
 if TYPE_CHECKING:
     from gnngarment.inference.animate import Animation
@@ -18,7 +19,8 @@ def check_animation(animation: Animation, body: bool = False) -> None:
     Checks the shapes the exporters rely on: ``rest_pos (N, 3)``, ``faces (F, 3)`` with
     indices in range, ``posed (T, N, 3)`` with ``T ≥ 1``, ``weights (T, N, 24)``,
     ``joint_transforms (T, 24, 4, 4)``, ``rest_joints (24, 3)``, ``fps > 0``, all finite;
-    with ``body`` also ``body_vertices (T, N_b, 3)`` and ``body_faces (F_b, 3)``.
+    ``uv (K, 2)`` and ``uv_faces (F, 3)`` both or neither; with ``body`` also
+    ``body_vertices (T, N_b, 3)`` and ``body_faces (F_b, 3)``.
     """
     rest = np.asarray(animation.rest_pos)
     posed = np.asarray(animation.posed)
@@ -44,6 +46,10 @@ def check_animation(animation: Animation, body: bool = False) -> None:
             raise ValueError(f"{name} contains NaN or inf")
     if not (np.isfinite(animation.fps) and animation.fps > 0):
         raise ValueError(f"fps must be positive, got {animation.fps}")
+    if (animation.uv is None) != (animation.uv_faces is None):
+        raise ValueError("uv and uv_faces must be given together (or both None)")
+    if animation.uv is not None:
+        check_texture_coordinates(animation.uv, animation.uv_faces, len(animation.faces))
     if body:
         vertices = np.asarray(animation.body_vertices)
         if vertices.ndim != 3 or vertices.shape[0] != frames or vertices.shape[2] != 3:

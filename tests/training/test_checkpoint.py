@@ -1,0 +1,75 @@
+"""Checkpoints carry a content hash (checked on load) and the environment they were made in."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from gnngarment.model import GarmentDeformer
+from gnngarment.training.checkpoint import (
+    CHECKPOINT_FORMAT_VERSION,
+    load_checkpoint,
+    load_model,
+    model_payload,
+    release_checkpoint,
+    save_checkpoint,
+)
+from tests.model.pairs import tiny_config
+
+
+@pytest.fixture(scope="module")
+def model() -> GarmentDeformer:
+    torch.manual_seed(0)
+    return GarmentDeformer(tiny_config())
+
+
+def test_flipped_tensor_bytes_are_refused_naming_the_file(model: GarmentDeformer,
+                                                           tmp_path: Path) -> None:
+    path = tmp_path / "model.pt"
+    save_checkpoint(path, model_payload(model))
+    data = bytearray(path.read_bytes())
+    # The raw bytes of one weight matrix (torch stores tensors uncompressed): flip 64 of
+    # them in place, the damage a bad disk or copy does without breaking the zip.
+    weight = next(t for t in model.state_dict().values() if t.numel() >= 64)
+    start = bytes(data).find(weight.numpy().tobytes())
+    assert start > 0
+    data[start:start + 64] = bytes(b ^ 0xFF for b in data[start:start + 64])
+    corrupt = tmp_path / "corrupt.pt"
+    corrupt.write_bytes(bytes(data))
+    for load in (load_checkpoint, load_model):
+        with pytest.raises(ValueError, match=r"corrupt.pt is corrupt: content hash mismatch"
+                           ) as raised:
+            load(corrupt)
+        assert "\n" not in str(raised.value)
+    load_model(path)  # the intact file still loads
+
+
+def test_checkpoint_without_a_hash_loads_unchecked(model: GarmentDeformer,
+                                                   tmp_path: Path) -> None:
+    path = tmp_path / "old.pt"  # as saved before hashes were stored
+    torch.save({"format_version": CHECKPOINT_FORMAT_VERSION, **model_payload(model)}, path)
+    loaded = load_model(path)
+    for (name, a), b in zip(model.state_dict().items(), loaded.state_dict().values(),
+                            strict=True):
+        assert torch.equal(a, b), name
+
+
+def test_every_checkpoint_records_threads_and_library_versions(model: GarmentDeformer,
+                                                               tmp_path: Path) -> None:
+    import torch_geometric
+
+    path = tmp_path / "model.pt"
+    save_checkpoint(path, model_payload(model))
+    environment = load_checkpoint(path)["environment"]
+    assert environment["torch_threads"] == torch.get_num_threads()
+    assert environment["torch"] == torch.__version__
+    assert environment["numpy"] == np.__version__
+    assert environment["torch_geometric"] == torch_geometric.__version__
+    # A released model keeps the environment of the run that made it, under a valid hash.
+    recorded = {**environment, "torch_threads": 7}
+    save_checkpoint(path, {**model_payload(model), "environment": recorded})
+    released = release_checkpoint(path, tmp_path / "released.pt")
+    assert load_checkpoint(released)["environment"] == recorded
