@@ -83,15 +83,21 @@ def collision_rate(pred: np.ndarray, body_points: np.ndarray, body_normals: np.n
     return rates
 
 
+#: A body vertex belongs to a joint's region when the joint moves it at least this much.
+REGION_WEIGHT = 0.1
+
+
 def far_joint_weight(weights: np.ndarray, rest_pos: np.ndarray, body_rest_vertices: np.ndarray,
                      body_skinning_weights: np.ndarray, radius: float = 0.20
                      ) -> dict[str, float]:
     """Skinning weight a garment puts on joints whose body part is far away: for each
     vertex, the summed weight on the joints whose body region lies more than ``radius``
-    from the vertex's rest position. A joint's region is the body vertices whose
-    dominant skinning joint it is; its distance is that of the region's nearest vertex.
-    A joint that dominates no body vertex has no region and counts as far. Such weight
-    makes the vertex follow a distant limb (a hem dragged along by a wrist).
+    from the vertex's rest position. A joint's region is the body vertices it moves
+    noticeably (skinning weight ≥ ``REGION_WEIGHT``); its distance is that of the
+    region's nearest vertex. A joint that moves no body vertex counts as far. Such
+    weight makes the vertex follow a distant limb (a hem dragged along by a wrist).
+    (Regions by *dominant* joint were tried first and are wrong: Anny's pelvis dominates
+    no vertex, so a skirt skinned to the pelvis counted as 100 % far.)
 
     Shapes:
         weights ``(T, N, 24)`` or ``(N, 24)`` garment skinning weights, rest_pos
@@ -111,10 +117,10 @@ def far_joint_weight(weights: np.ndarray, rest_pos: np.ndarray, body_rest_vertic
     if weights.ndim != 3 or weights.shape[1:] != (len(rest_pos), joints):
         raise ValueError(f"weights must be (T, {len(rest_pos)}, {joints}) or "
                          f"({len(rest_pos)}, {joints}), got {weights.shape}")
-    dominant = np.argmax(body_skinning_weights, axis=1)
     distance = np.full((len(rest_pos), joints), np.inf)
-    for joint in np.unique(dominant):
-        region = body_rest_vertices[dominant == joint]
-        distance[:, joint] = cKDTree(region).query(rest_pos)[0]
+    for joint in range(joints):
+        region = body_rest_vertices[body_skinning_weights[:, joint] >= REGION_WEIGHT]
+        if len(region):
+            distance[:, joint] = cKDTree(region).query(rest_pos)[0]
     far = (weights * (distance > radius)[None]).sum(-1)                # (T, N)
     return {"max": float(far.max()), "mean": float(far.mean())}

@@ -75,14 +75,16 @@ def test_perturbation_moves_only_the_subtree() -> None:
 
 
 def test_far_joint_weight_counts_weight_on_distant_body_regions() -> None:
-    # Body: joint 0 dominates a cluster at x = 0, joint 1 one at x = 1 (each vertex
-    # also carries a little weight on joint 2, which dominates nothing).
+    # Body: joint 0 moves a cluster at x = 0 (with joint 3, which dominates no vertex but
+    # moves them by 0.3, as Anny's pelvis does), joint 1 one at x = 1; every vertex
+    # carries a trace of joint 2, below the region threshold.
     body = np.array([[0.0, 0, 0], [0.0, 0.1, 0], [1.0, 0, 0], [1.0, 0.1, 0]])
     body_weights = np.zeros((4, 24))
-    body_weights[:2, 0], body_weights[2:, 1], body_weights[:, 2] = 0.9, 0.9, 0.1
+    body_weights[:2, 0], body_weights[:2, 3] = 0.65, 0.3
+    body_weights[2:, 1], body_weights[:, 2] = 0.95, 0.05
     rest = np.array([[0.05, 0, 0], [0.95, 0, 0]])   # garment vertices near each cluster
     weights = np.zeros((2, 2, 24))
-    weights[0, 0, [0, 1]] = 0.7, 0.3                 # 0.3 on the far joint 1
+    weights[0, 0, [3, 1]] = 0.7, 0.3                 # joint 3 is near; 0.3 on far joint 1
     weights[0, 1, 1] = 1.0                           # all on its own region
     weights[1, 0, 0] = 1.0
     weights[1, 1, [1, 2]] = 0.4, 0.6                 # 0.6 on joint 2: no region, far
