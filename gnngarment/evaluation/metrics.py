@@ -94,8 +94,10 @@ def far_joint_weight(weights: np.ndarray, rest_pos: np.ndarray, body_rest_vertic
     vertex, the summed weight on the joints whose body region lies more than ``radius``
     from the vertex's rest position. A joint's region is the body vertices it moves
     noticeably (skinning weight ≥ ``REGION_WEIGHT``); its distance is that of the
-    region's nearest vertex. A joint that moves no body vertex counts as far. Such
-    weight makes the vertex follow a distant limb (a hem dragged along by a wrist).
+    region's nearest vertex, counted from the vertex's nearest body vertex (so a hem
+    hanging 25 cm off the legs is not "far" from the legs). A joint that moves no body
+    vertex counts as far. Such weight makes the vertex follow a distant limb (a hem
+    dragged along by a wrist).
     (Regions by *dominant* joint were tried first and are wrong: Anny's pelvis dominates
     no vertex, so a skirt skinned to the pelvis counted as 100 % far.)
 
@@ -122,5 +124,6 @@ def far_joint_weight(weights: np.ndarray, rest_pos: np.ndarray, body_rest_vertic
         region = body_rest_vertices[body_skinning_weights[:, joint] >= REGION_WEIGHT]
         if len(region):
             distance[:, joint] = cKDTree(region).query(rest_pos)[0]
-    far = (weights * (distance > radius)[None]).sum(-1)                # (T, N)
+    nearest = cKDTree(body_rest_vertices).query(rest_pos)[0]           # (N,)
+    far = (weights * (distance - nearest[:, None] > radius)[None]).sum(-1)  # (T, N)
     return {"max": float(far.max()), "mean": float(far.mean())}
