@@ -10,25 +10,12 @@ from types import ModuleType
 
 
 def import_warp() -> ModuleType:
-    """``warp``, initialised quietly on the CPU.
+    """``warp``, initialised quietly on the CPU (one home:
+    :func:`gnngarment.geometry.signed_distance.import_warp`; the dataset builder runs
+    thousands of simulations and its log should show only their reports)."""
+    from gnngarment.geometry.signed_distance import import_warp as quiet_warp
 
-    Raises:
-        ImportError: warp-lang is not installed (with the pip command that fixes it).
-    """
-    try:
-        import warp as wp
-    except ImportError as error:  # pragma: no cover - depends on the environment
-        raise ImportError(
-            "the reference cloth simulation needs NVIDIA Warp: pip install 'warp-lang>=1.19'"
-        ) from error
-    # Warp prints its banner, a "no CUDA driver" warning and every module load otherwise;
-    # the dataset builder runs thousands of simulations and its log should show only
-    # their reports. (Warp 1.19 reads log_level; older versions read quiet.)
-    wp.config.quiet = True
-    if hasattr(wp, "LOG_ERROR"):
-        wp.config.log_level = wp.LOG_ERROR
-    wp.init()
-    return wp
+    return quiet_warp()
 
 
 def import_newton() -> ModuleType:

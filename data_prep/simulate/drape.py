@@ -21,7 +21,7 @@ import numpy as np
 from data_prep.simulate.fabrics import FabricPreset, resolve_fabric
 from data_prep.simulate.quality import QualityReport
 from data_prep.simulate.settings import SimulationSettings
-from data_prep.simulate.simulate import ProgressCallback, SimulationFailed, _Gauge
+from data_prep.simulate.simulate import ProgressCallback, _Gauge, with_retries
 from data_prep.simulate.validation import validate_inputs
 
 #: Default: a garment is at rest when no vertex moves 1 mm in a frame (1/30 s).
@@ -88,20 +88,8 @@ def drape_garment(garment: np.ndarray, faces: np.ndarray, body_vertices: np.ndar
     preset = resolve_fabric(fabric)
     body = np.asarray(body_vertices, dtype=np.float32)[None]
     inputs = validate_inputs(garment, faces, body, body_faces, fps, pinned, None)
-    reports: list[QualityReport] = []
-    substeps = settings.substeps
-    for attempt in range(settings.max_retries + 1):
-        result, report = _attempt(inputs, preset, settings, substeps, max_frames, rest_speed,
-                                  progress)
-        reports.append(report)
-        if result is not None:
-            result.attempts = attempt + 1
-            return result
-        if (settings.retry_only_if_progress and attempt > 0
-                and report.frames_simulated <= reports[-2].frames_simulated):
-            break
-        substeps *= settings.retry_substep_factor
-    raise SimulationFailed(reports)
+    return with_retries(lambda substeps: _attempt(inputs, preset, settings, substeps,
+                                                  max_frames, rest_speed, progress), settings)
 
 
 def _attempt(inputs, fabric: FabricPreset, settings: SimulationSettings, substeps: int,

@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -107,15 +107,28 @@ def simulate_garment(garment_rest: np.ndarray, garment_faces: np.ndarray,
     preset = resolve_fabric(fabric)
     inputs = validate_inputs(garment_rest, garment_faces, body_vertices, body_faces, fps,
                              pinned, pin_targets)
+    return with_retries(lambda substeps: _attempt(inputs, preset, settings, substeps,
+                                                  progress), settings)
+
+
+def with_retries(attempt: Callable[[int], tuple[Any, QualityReport]],
+                 settings: SimulationSettings) -> Any:
+    """Run ``attempt(substeps)`` until it returns a result (not ``None``), with
+    ``retry_substep_factor`` times more substeps each retry, at most
+    ``1 + max_retries`` times; sets the result's ``attempts``.
+
+    Raises:
+        SimulationFailed: every attempt failed a gate (or a retry got no further).
+    """
     reports: list[QualityReport] = []
     substeps = settings.substeps
-    for attempt in range(settings.max_retries + 1):
-        result, report = _attempt(inputs, preset, settings, substeps, progress)
+    for number in range(settings.max_retries + 1):
+        result, report = attempt(substeps)
         reports.append(report)
         if result is not None:
-            result.attempts = attempt + 1
+            result.attempts = number + 1
             return result
-        if (settings.retry_only_if_progress and attempt > 0
+        if (settings.retry_only_if_progress and number > 0
                 and report.frames_simulated <= reports[-2].frames_simulated):
             break  # more substeps did not get further: a third try would not either
         substeps *= settings.retry_substep_factor
