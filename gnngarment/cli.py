@@ -155,9 +155,15 @@ def prepare(
         if smpl_model is None:
             raise fail("--from-cloth3d needs --smpl-model FILE (SMPL is not shipped: get it "
                        "from https://smpl.is.tue.mpg.de)")
+        from gnngarment.body.smpl_model import SMPLBodyModel
+
         try:
+            # A missing or unreadable model fails before any work (a folder holds one
+            # file per gender, read per sequence).
+            if not smpl_model.is_dir():
+                SMPLBodyModel(smpl_model)
             report = build_from_cloth3d(from_cloth3d, smpl_model, output or Path("data/cloth3d"))
-        except ValueError as error:
+        except (ValueError, OSError) as error:  # SMPLModelError is a FileNotFoundError
             raise fail(str(error)) from None
         console.print(report)
         return

@@ -152,3 +152,20 @@ def test_train_refuses_what_it_cannot_do_as_asked(tiny_cache: Path, tmp_path: Pa
     assert result.exit_code == 2, result.output
     assert "--resume: " in result.output and "not a readable" in result.output
     assert len(result.output.strip().splitlines()) == 1  # torch's message spans many lines
+
+
+@pytest.mark.parametrize("content", [None, b"not an smpl model"])
+def test_prepare_from_cloth3d_with_a_bad_smpl_model_is_one_line_exit_2(
+        tmp_path: Path, content: bytes | None) -> None:
+    """Issue 13 item 6: a missing or unreadable --smpl-model gave a 55-69-line traceback
+    and exit 1; it is checked before any sequence is read."""
+    (tmp_path / "cloth3d" / "00001").mkdir(parents=True)
+    model = tmp_path / "SMPL_FEMALE.npz"
+    if content is not None:
+        model.write_bytes(content)
+    result = runner.invoke(app, ["prepare", "--from-cloth3d", str(tmp_path / "cloth3d"),
+                                 "--smpl-model", str(model), "--output", str(tmp_path / "out")])
+    assert result.exit_code == 2
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and str(model) in " ".join(result.output.split())
+    assert "Traceback" not in result.output and not (tmp_path / "out").exists()

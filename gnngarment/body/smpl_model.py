@@ -60,6 +60,10 @@ def _read_npz_without_code(path: Path) -> dict[str, np.ndarray]:
     """Every array of an SMPL ``.npz``, refusing pickled objects: unpickling an untrusted
     file can run code (a ``v_template`` holding a pickle ran ``os.system``), and SMPL's
     arrays are all plain numbers and strings."""
+    import zipfile
+
+    if not zipfile.is_zipfile(path):  # np.load would take any other file for a pickle
+        raise SMPLModelError(f"{path}: not an .npz archive (expected the SMPL model's arrays)")
     try:
         with np.load(path, allow_pickle=False) as archive:
             return {name: archive[name] for name in archive.files}
