@@ -296,12 +296,12 @@ def drape_and_prepare_garment(task: tuple[str, DesignPlan, BodyPlan, DataConfig,
                                   max_frames=config.drape_frames,
                                   rest_speed=config.drape_rest_speed)
         except SimulationFailed as error:
-            return _garment_left_out(root, name, inputs_hash, f"drape: {error}", started)
+            return _left_out(root, name, inputs_hash, f"drape: {error}", started, "garments")
         samples = body_model.feature_vertex_indices(config.collision_points)
         off = left_the_body(drape.positions[None], body_vertices[samples][None],
                             rest=made.pos)
         if off:
-            return _garment_left_out(root, name, inputs_hash, f"drape: {off}", started)
+            return _left_out(root, name, inputs_hash, f"drape: {off}", started, "garments")
         pos = drape.positions.astype(np.float64)
         prepared = prepare_garment(pos, made.faces, GarmentPreparationConfig(
             levels=config.levels, landmarks=config.landmarks), source=name)
@@ -323,20 +323,7 @@ def drape_and_prepare_garment(task: tuple[str, DesignPlan, BodyPlan, DataConfig,
                 "drape_mean_displacement_mm": 1000 * drape.mean_displacement,
                 "seconds": time.perf_counter() - started}
     except Exception as error:  # a broken design on this body: report, don't kill the build
-        import traceback
-
-        where = traceback.extract_tb(error.__traceback__)[-1]
-        return {"name": name, "ok": False,
-                "reason": f"{type(error).__name__}: {error} ({Path(where.filename).name}:"
-                          f"{where.lineno})", "seconds": time.perf_counter() - started}
-
-
-def _garment_left_out(root: Path, name: str, inputs_hash: str, reason: str,
-                      started: float) -> dict[str, Any]:
-    atomic_write_bytes(root / "garments" / f"{name}.failed",
-                       json.dumps({"inputs_hash": inputs_hash, "reason": reason}).encode())
-    return {"name": name, "ok": False, "reason": reason,
-            "seconds": time.perf_counter() - started}
+        return _crashed(name, error, started)
 
 
 def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[str, Any]:
@@ -411,19 +398,25 @@ def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[s
     except SimulationFailed as error:
         return _left_out(root, plan.name, inputs_hash, str(error), started)
     except Exception as error:  # a broken garment or body: report, don't kill the build
-        import traceback
+        return _crashed(plan.name, error, started)
 
-        where = traceback.extract_tb(error.__traceback__)[-1]
-        return {"name": plan.name, "ok": False,
-                "reason": f"{type(error).__name__}: {error} ({Path(where.filename).name}:"
-                          f"{where.lineno})", "seconds": time.perf_counter() - started}
+
+def _crashed(name: str, error: Exception, started: float) -> dict[str, Any]:
+    """The status dict of a worker task that raised: the error and where it was raised."""
+    import traceback
+
+    where = traceback.extract_tb(error.__traceback__)[-1]
+    return {"name": name, "ok": False,
+            "reason": f"{type(error).__name__}: {error} ({Path(where.filename).name}:"
+                      f"{where.lineno})", "seconds": time.perf_counter() - started}
 
 
 def _left_out(root: Path, name: str, inputs_hash: str, reason: str,
-              started: float) -> dict[str, Any]:
-    """Record a sequence that failed its quality gates (with its input hash, so that a
-    resumed build does not simulate it again) and return its status dict."""
-    folder = root / "sequences"
+              started: float, kind: str = "sequences") -> dict[str, Any]:
+    """Record a sequence (``kind="garments"``: a garment's drape) that failed its quality
+    gates (with its input hash, so that a resumed build does not simulate it again) and
+    return its status dict."""
+    folder = root / kind
     folder.mkdir(parents=True, exist_ok=True)
     atomic_write_bytes(folder / f"{name}.failed",
                        json.dumps({"inputs_hash": inputs_hash, "reason": reason}).encode())
