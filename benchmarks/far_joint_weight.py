@@ -26,7 +26,6 @@ if str(ROOT) not in sys.path:
 
 from data_prep.posed_bodies import synthetic_body_meshes, synthetic_skinning_weights  # noqa: E402
 from gnngarment.data import PreparedDataset  # noqa: E402
-from gnngarment.data.cache import read_garment  # noqa: E402
 from gnngarment.evaluation.evaluate import predict  # noqa: E402
 from gnngarment.evaluation.metrics import far_joint_weight  # noqa: E402
 from gnngarment.training.checkpoint import load_model  # noqa: E402
@@ -52,9 +51,9 @@ def main() -> None:
             continue
         rest = dataset.garment_of(name).pair.rest_pos.numpy()
         body = mesh[0][0]  # frame 0: every procedural motion starts in the rest pose
-        garment = read_garment(dataset.root, dataset.manifest["sequences"][name]["garment"])
+        body_weights = dataset.garment_of(name).pair.body_weights.numpy()
         found.setdefault("body skinning", []).append(
-            far_joint_weight(garment.body_weights, rest, body, skinning))
+            far_joint_weight(body_weights, rest, body, skinning))
         for label, model in models.items():
             weights = predict(model, dataset, name, return_weights=True)[1]
             found.setdefault(label, []).append(far_joint_weight(weights, rest, body, skinning))

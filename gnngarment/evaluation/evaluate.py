@@ -262,8 +262,7 @@ def evaluate(models: dict[str, GarmentDeformer], dataset: PreparedDataset,
             if pred is not None:
                 values = resolved_sequence_metrics(pred, dataset, name, body_mesh, collisions)
                 if regions:
-                    garment_weights = read_garment(dataset.root, dataset.manifest["sequences"]
-                                                   [name]["garment"]).body_weights
+                    garment_weights = dataset.garment_of(name).pair.body_weights.numpy()
                     values["far_weight_pct"] = 100 * metrics.far_joint_weight(
                         garment_weights, rest, body_mesh[0][0], body_skinning_weights)["max"]
                 if spurious:
