@@ -141,8 +141,15 @@ def prepare(
     from_cloth3d: Annotated[Path | None, typer.Option(
         "--from-cloth3d", help="Build the cache from a CLOTH3D folder instead.")] = None,
     smpl_model: Annotated[Path | None, typer.Option(
-        help="SMPL model file (CLOTH3D): .npz, or a .pkl from a trusted source only (a "
+        help="SMPL model file for both genders (CLOTH3D), or a folder holding "
+             "SMPL_FEMALE/SMPL_MALE.pkl|npz: .npz, or a .pkl from a trusted source only (a "
              "pickle can run code).")] = None,
+    smpl_model_female: Annotated[Path | None, typer.Option(
+        help="SMPL model for CLOTH3D sequences with gender 0 (overrides --smpl-model).")
+                                 ] = None,
+    smpl_model_male: Annotated[Path | None, typer.Option(
+        help="SMPL model for CLOTH3D sequences with gender 1 (overrides --smpl-model).")
+                               ] = None,
     output: Annotated[Path | None, typer.Option(help="Cache folder (overrides the config).")
                       ] = None,
 ) -> None:
@@ -152,17 +159,15 @@ def prepare(
     if from_cloth3d is not None:
         from data_prep.cloth3d_build import build_from_cloth3d
 
-        if smpl_model is None:
-            raise fail("--from-cloth3d needs --smpl-model FILE (SMPL is not shipped: get it "
-                       "from https://smpl.is.tue.mpg.de)")
-        from gnngarment.body.smpl_model import SMPLBodyModel
-
+        if smpl_model is None and smpl_model_female is None and smpl_model_male is None:
+            raise fail("--from-cloth3d needs --smpl-model FILE|FOLDER or --smpl-model-female/"
+                       "--smpl-model-male FILE (SMPL is not shipped: get it from "
+                       "https://smpl.is.tue.mpg.de)")
         try:
-            # A missing or unreadable model fails before any work (a folder holds one
-            # file per gender, read per sequence).
-            if not smpl_model.is_dir():
-                SMPLBodyModel(smpl_model)
-            report = build_from_cloth3d(from_cloth3d, smpl_model, output or Path("data/cloth3d"))
+            # Missing or unreadable models, and genders without one, fail before any work.
+            report = build_from_cloth3d(from_cloth3d, smpl_model, output or Path("data/cloth3d"),
+                                        smpl_model_female=smpl_model_female,
+                                        smpl_model_male=smpl_model_male)
         except (ValueError, OSError) as error:  # SMPLModelError is a FileNotFoundError
             raise fail(str(error)) from None
         console.print(report)
@@ -316,6 +321,29 @@ def _load_body_and_motion(body_shape: str, motion: str, fps: float, duration: fl
     return body_model, shape, motion_value
 
 
+def _drape(placed, faces, body_inputs, garment_mesh: Path):
+    """``animate --drape``: the garment settled on the rest body, with a progress bar, or
+    a clear failure."""
+    from tqdm import tqdm
+
+    from data_prep.simulate import SimulationFailed
+    from gnngarment.inference.placement import drape_on_rest_body
+
+    bar = tqdm(desc="draping on the rest body", unit="frame")
+
+    def advance(done: int, total: int) -> None:
+        bar.total = total
+        bar.update(done - bar.n)
+
+    try:
+        placed = drape_on_rest_body(placed, faces, body_inputs, progress=advance)
+    except (ValueError, SimulationFailed) as error:
+        raise fail(f"{garment_mesh}: the drape failed: {error}") from None
+    finally:
+        bar.close()
+    return placed
+
+
 @app.command()
 def animate(
     garment_mesh: Annotated[Path, typer.Argument(help="Garment in the rest body's frame.")],
@@ -334,6 +362,17 @@ def animate(
     fix_units: Annotated[str, typer.Option(
         "--fix-units", help="Garment units: auto, m, cm or mm.")] = "auto",
     up_axis: Annotated[str, typer.Option(help="Garment up axis: z, y or auto.")] = "z",
+    scale: Annotated[float | None, typer.Option(
+        help="Metres per unit of the garment file (instead of --fix-units).")] = None,
+    offset: Annotated[tuple[float, float, float] | None, typer.Option(
+        help="Move the garment by X Y Z metres (rest body frame, Z up) after the scale "
+             "and turn.")] = None,
+    source_body: Annotated[Path | None, typer.Option(
+        help="The body mesh the garment was modelled on (any topology, units, up axis; "
+             "T-pose): the garment is fitted from it onto the rest body.")] = None,
+    drape: Annotated[bool, typer.Option(
+        help="Settle the garment on the rest body with the reference simulator first "
+             "(for a garment that is not draped yet).")] = False,
     ignore_placement: Annotated[bool, typer.Option(
         help="Animate even if the garment does not sit on the body.")] = False,
     influences: Annotated[int, typer.Option(help="Joints per vertex in the glb skin.")] = 4,
@@ -346,10 +385,11 @@ def animate(
 
     from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs
     from gnngarment.geometry.errors import MeshError
-    from gnngarment.geometry.mesh_io import load_textured_mesh
+    from gnngarment.geometry.mesh_io import load_mesh, load_textured_mesh
     from gnngarment.inference.animate import animate as run_animation
-    from gnngarment.inference.checks import check_garment_placement, fix_placement
+    from gnngarment.inference.checks import check_garment_placement
     from gnngarment.inference.export import export_animation
+    from gnngarment.inference.placement import place_garment
     from gnngarment.paths import SHIPPED_MODEL
     from gnngarment.training.checkpoint import load_model
 
@@ -359,17 +399,21 @@ def animate(
     try:
         model = load_model(checkpoint)
         pos, faces, uv, uv_faces = load_textured_mesh(garment_mesh)
+        source = None if source_body is None else load_mesh(source_body)
     except (MeshError, ValueError) as error:
         raise fail(str(error)) from None
     body_model, shape, motion_value = _load_body_and_motion(body_shape, motion, fps, duration)
     body_inputs = body_shape_inputs(body_model, shape, model.config.body_vertices)
     try:
-        pos, message = fix_placement(pos, units=fix_units, up_axis=up_axis,
-                                     body_vertices=body_inputs.rest_vertices,
-                                     body_faces=body_inputs.faces)
+        placed = place_garment(pos, faces, body_inputs, units=fix_units, up_axis=up_axis,
+                               scale=scale, offset=None if offset is None else list(offset),
+                               source_body=source)
     except ValueError as error:
-        raise fail(f"{garment_mesh}: {error}") from None
-    if message:
+        raise fail(f"{source_body or garment_mesh}: {error}") from None
+    if drape:
+        placed = _drape(placed, faces, body_inputs, garment_mesh)
+    pos = placed.pos
+    for message in placed.messages:
         console.print(f"[yellow]placement:[/] {message}")
     findings = check_garment_placement(pos, faces, body_inputs.rest_vertices, body_inputs.faces)
     for finding in findings:
@@ -377,7 +421,8 @@ def animate(
         console.print(f"[{colour}]{finding.severity}:[/] {garment_mesh}: {finding.message}")
     if any(f.severity == "error" for f in findings) and not ignore_placement:
         raise fail(f"{garment_mesh}: the garment is not on the rest body (see above; fix it "
-                   "or pass --fix-units/--up-axis, or --ignore-placement)")
+                   "or pass --source-body, --fix-units/--scale, --up-axis, --offset, or "
+                   "--ignore-placement)")
     frames = body_motion_inputs(body_model, shape, motion_value, model.config.body_vertices)
     bar = tqdm(total=len(motion_value), desc="animating", unit="frame")
 

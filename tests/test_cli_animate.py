@@ -145,3 +145,50 @@ def test_input_uvs_are_carried_into_the_obj_and_glb_exports(files) -> None:
     document = read_glb(out / "textured.glb").document
     assert "TEXCOORD_0" in document["meshes"][0]["primitives"][0]["attributes"]
     assert document["meshes"][0]["extras"]["seamSources"] == [0]
+
+
+def test_a_garment_is_fitted_from_the_body_it_was_made_on(files, anny_body) -> None:
+    """The skirt modelled on a heavier body given as an SMPL-style file (Y up, facing +Z,
+    centimetres): ``--source-body`` brings it onto the rest body at the distance it had
+    from its own body; the placement checks then pass."""
+    from gnngarment.inference.checks import Z_UP_FROM_Y_UP, _Surface
+
+    heavy = anny_body.rest(anny_body.parse_shape("heavy_female"))
+    source = heavy.vertices.numpy().astype(np.float64)
+    pelvis = heavy.joints[0].numpy()
+    pos, faces = flared_skirt(400, waist_radius=0.2, hem_radius=0.27, length=0.3,
+                              waist_height=pelvis[2] + 0.08, seed=1)
+    pos[:, :2] += pelvis[:2]
+    gap = np.median(np.abs(_Surface(source, anny_body.faces).signed_distance(pos)))
+    folder = files["folder"]
+    trimesh.Trimesh(100 * pos @ Z_UP_FROM_Y_UP, faces, process=False).export(
+        folder / "heavy_skirt.obj")
+    trimesh.Trimesh(100 * source @ Z_UP_FROM_Y_UP, anny_body.faces, process=False).export(
+        folder / "heavy_body.obj")
+    out = folder / "fitted"
+    result = runner.invoke(app, ["animate", str(folder / "heavy_skirt.obj"), "--source-body",
+                                 str(folder / "heavy_body.obj"), "--checkpoint",
+                                 str(files["checkpoint"]), "--out", str(out), "--duration",
+                                 "0.1", "--format", "pc2", "--no-body",
+                                 "--no-resolve-collisions"])
+    assert result.exit_code == 0, result.output
+    assert "fitted from the source body" in " ".join(result.output.split())
+    rest, _ = load_mesh(out / "heavy_skirt_rest.obj")
+    average = anny_body.rest()
+    fitted_gap = np.median(np.abs(_Surface(average.vertices.numpy().astype(np.float64),
+                                           anny_body.faces).signed_distance(rest)))
+    assert gap < 0.08 and abs(fitted_gap - gap) < 0.01, (gap, fitted_gap)
+
+
+def test_source_body_with_explicit_placement_or_a_bad_file_exits_2(files, tmp_path) -> None:
+    base = ["animate", str(files["garment"]), "--checkpoint", str(files["checkpoint"]),
+            "--out", str(tmp_path / "o")]
+    cases = [
+        (["--source-body", str(tmp_path / "nobody.obj")], "nobody.obj: file not found"),
+        (["--source-body", str(files["garment"]), "--up-axis", "y"], "leave out --up-axis"),
+        (["--scale", "-1"], "scale must be a finite number > 0"),
+    ]
+    for extra, message in cases:
+        result = runner.invoke(app, base + extra)
+        assert result.exit_code == 2, (extra, result.output)
+        assert message in " ".join(result.output.split()), result.output

@@ -208,8 +208,9 @@ def inside_fraction(pos: np.ndarray, body_vertices: np.ndarray, body_faces: np.n
 
 def fix_placement(pos: np.ndarray, units: str = "auto", up_axis: str = "z",
                   body_vertices: np.ndarray | None = None,
-                  body_faces: np.ndarray | None = None) -> tuple[np.ndarray, str]:
-    """Rescale to metres and turn to Z up.
+                  body_faces: np.ndarray | None = None, scale: float | None = None,
+                  offset: np.ndarray | None = None) -> tuple[np.ndarray, str]:
+    """Rescale to metres, turn to Z up, then move by an explicit offset.
 
     Args:
         pos: ``(N, 3)`` garment vertices as given.
@@ -219,6 +220,10 @@ def fix_placement(pos: np.ndarray, units: str = "auto", up_axis: str = "z",
             or ``"auto"`` (:func:`detect_up_axis`; needs ``body_vertices``).
         body_vertices, body_faces: ``(N_b, 3)`` rest body (and its ``(F_b, 3)`` faces,
             optional), for the automatic choices.
+        scale: metres per file unit, replacing the unit choice (``units`` must then be
+            ``"auto"``): for a mesh whose units no rule can guess.
+        offset: ``(3,)`` metres added after the scale and the turn (in the rest body's
+            frame, Z up): for a garment made with another origin, e.g. feet at zero.
 
     Returns:
         ``(pos, message)``: corrected float64 positions (same vertex order) and what was
@@ -233,9 +238,17 @@ def fix_placement(pos: np.ndarray, units: str = "auto", up_axis: str = "z",
     if up_axis not in ("z", "y", "auto"):
         raise ValueError(f"up_axis must be 'z', 'y' or 'auto', got {up_axis!r}")
     body = None if body_vertices is None else _points(body_vertices, "body_vertices")
+    applied: dict[str, str] = {}
+    if scale is not None:
+        if units != "auto":
+            raise ValueError(f"give either a scale or units, not both (units {units!r})")
+        if not (np.isfinite(scale) and scale > 0):
+            raise ValueError(f"scale must be a finite number > 0, got {scale}")
+        pos = pos * scale
+        applied["scale"] = f"{scale:g}"
+        units = "m"
     if units == "auto":
         units = detect_units(pos, body) or "m"
-    applied: dict[str, str] = {}
     if units != "m":
         pos = pos * UNIT_SCALES[units]
         applied["units"] = units
@@ -246,16 +259,26 @@ def fix_placement(pos: np.ndarray, units: str = "auto", up_axis: str = "z",
     if up_axis == "y":
         pos = pos @ Z_UP_FROM_Y_UP.T
         applied["up_axis"] = "y"
+    if offset is not None:
+        offset = np.asarray(offset, dtype=np.float64)
+        if offset.shape != (3,) or not np.isfinite(offset).all():
+            raise ValueError(f"offset must be 3 finite numbers (metres), got {offset.tolist()}")
+        pos = pos + offset
+        applied["offset"] = "({:+.3f}, {:+.3f}, {:+.3f})".format(*offset)
     return pos, _describe(applied) if applied else "kept as given (metres, Z up)"
 
 
 def _describe(fix: dict[str, str]) -> str:
     parts = []
+    if "scale" in fix:
+        parts.append(f"scaled by {fix['scale']} (given)")
     if "units" in fix:
         name = {"cm": "centimetres", "mm": "millimetres"}[fix["units"]]
         parts.append(f"scaled {name} to metres (×{UNIT_SCALES[fix['units']]:g})")
     if fix.get("up_axis") == "y":
         parts.append("turned Y-up to Z-up ((x, y, z) → (x, −z, y))")
+    if "offset" in fix:
+        parts.append(f"moved by {fix['offset']} m (given)")
     return "; ".join(parts)
 
 

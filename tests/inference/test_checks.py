@@ -140,3 +140,27 @@ def test_validation(body, garment) -> None:
     with pytest.raises(ValueError, match="needs body_vertices"):
         fix_placement(garment[0], up_axis="auto")
     assert fix_placement(garment[0], units="auto")[1] == "kept as given (metres, Z up)"
+
+
+def test_explicit_scale_and_offset(body, garment) -> None:
+    """A mesh in an unknown unit (×10: no rule guesses it) with its feet at the origin:
+    ``--scale`` and ``--offset`` put it back exactly, and say so."""
+    moved = (garment[0] - [0.0, 0.0, -0.8]) * 10.0
+    assert detect_units(moved, body[0]) is None
+    fixed, message = fix_placement(moved, scale=0.1, offset=np.array([0.0, 0.0, -0.8]),
+                                   body_vertices=body[0])
+    np.testing.assert_allclose(fixed, garment[0], atol=1e-12)
+    assert "scaled by 0.1 (given)" in message and "moved by (+0.000, +0.000, -0.800)" in message
+    assert check_garment_placement(fixed, garment[1], *body) == []
+
+
+@pytest.mark.parametrize(("options", "problem"), [
+    ({"scale": 0.0}, "scale must be a finite number > 0"),
+    ({"scale": float("nan")}, "scale must be a finite number > 0"),
+    ({"scale": 0.01, "units": "cm"}, "either a scale or units"),
+    ({"offset": np.array([0.0, np.inf, 0.0])}, "offset must be 3 finite numbers"),
+    ({"offset": np.array([0.0, 1.0])}, "offset must be 3 finite numbers"),
+])
+def test_explicit_placement_is_validated(garment, options, problem) -> None:
+    with pytest.raises(ValueError, match=problem):
+        fix_placement(garment[0], **options)

@@ -1,0 +1,114 @@
+"""Real garments made on other bodies, fitted onto ours and animated (issue 13).
+
+For every garment of ``../shared/real-world/garments`` whose source body is in
+``../shared/real-world/bodies``: fit it from that body onto the rest body
+(``animate --source-body``, :func:`gnngarment.inference.placement.place_garment`),
+animate it on a walk with the shipped (or a given) model, and print
+
+* the fit: scale, registration error, seconds;
+* the median garment–body distance on its source body, on our rest body after the fit,
+  and on the walking body (mean over frames of the per-frame median), in mm;
+* the share of garment vertices inside the walking body after collision resolution
+  and in the network's raw output (%, mean over frames; inside = more than 2 mm deep,
+  the nearest-point sign of a dense body sampling).
+
+Targets (issue 13): inside < 1 % after resolution; walking median distance within 1 cm
+of the source-body distance.
+
+    .venv/bin/python benchmarks/real_garments.py [--checkpoint PATH] [--motion walk]
+        [--shared ../shared]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from gnngarment.body import AnnyBodyModel, load_motion  # noqa: E402
+from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs  # noqa: E402
+from gnngarment.geometry.mesh_io import load_mesh  # noqa: E402
+from gnngarment.inference.animate import animate  # noqa: E402
+from gnngarment.inference.checks import _Surface  # noqa: E402
+from gnngarment.inference.placement import place_garment  # noqa: E402
+from gnngarment.paths import SHIPPED_MODEL  # noqa: E402
+from gnngarment.training.checkpoint import load_model  # noqa: E402
+
+#: Garment → the body it was modelled on (../shared/real-world/README.md).
+SOURCE_BODIES = {
+    "snug_tank": "smpl_female_tpose_vto_body",
+    "snug_shorts": "smpl_female_tpose_vto_body",
+    "snug_long_sleeve_top": "smpl_female_tpose_vto_body",
+    "vto_dress": "smpl_female_tpose_vto_body",
+    "ncs_tshirt": "ncs_smpl_female_neutral_body",
+    "ncs_pants": "ncs_smpl_female_neutral_body",
+    "ncs_mannequin_tshirt": "ncs_mannequin_body",
+    "pbns_outfit_top_bottom": "pbns_body_restpose_from_mat",
+}
+#: Depth below the body surface that counts as inside (metres).
+INSIDE_DEPTH = 0.002
+
+
+def distances(pos: np.ndarray, vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Signed nearest-surface distance of ``pos (N, 3)`` to a body (negative inside)."""
+    return _Surface(np.asarray(vertices, dtype=np.float64), faces).signed_distance(
+        np.asarray(pos, dtype=np.float64))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--checkpoint", type=Path, default=SHIPPED_MODEL)
+    parser.add_argument("--motion", default="walk")
+    parser.add_argument("--shared", type=Path, default=ROOT.parent / "shared")
+    parser.add_argument("--frames-measured", type=int, default=10,
+                        help="Frames (evenly spaced) measured per garment.")
+    args = parser.parse_args()
+    torch.set_num_threads(1)
+    real = args.shared / "real-world"
+    if not real.is_dir():
+        raise SystemExit(f"{real}: not found (the real-world garments are not on this machine)")
+    model = load_model(args.checkpoint)
+    body_model = AnnyBodyModel()
+    shape = body_model.parse_shape("average")
+    body = body_shape_inputs(body_model, shape, model.config.body_vertices)
+    frames = body_motion_inputs(body_model, shape, load_motion(args.motion, fps=30.0),
+                                model.config.body_vertices)
+    print(f"checkpoint {args.checkpoint}, motion {args.motion} ({len(frames.vertices)} frames)")
+    print("| garment | vertices | fit s | registration mm | median distance mm: source | "
+          "rest | walking | inside % resolved | inside % raw | animate s |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for garment, source_name in SOURCE_BODIES.items():
+        pos, faces = load_mesh(real / "garments" / f"{garment}.obj")
+        source = load_mesh(real / "bodies" / f"{source_name}.obj")
+        placed = place_garment(pos, faces, body, source_body=source)
+        started = time.perf_counter()
+        result = animate(model, placed.pos, faces, body, frames)
+        seconds = time.perf_counter() - started
+        source_distance = np.median(np.abs(distances(pos, *source)))
+        rest_distance = np.median(np.abs(distances(result.rest_pos, body.rest_vertices,
+                                                   body.faces)))
+        chosen = np.linspace(0, len(frames.vertices) - 1, args.frames_measured).round()
+        walking, inside, raw_inside = [], [], []
+        for t in chosen.astype(int):
+            resolved = distances(result.posed[t], frames.vertices[t], body.faces)
+            raw = distances(result.raw_posed[t], frames.vertices[t], body.faces)
+            walking.append(np.median(np.abs(resolved)))
+            inside.append(np.mean(resolved < -INSIDE_DEPTH))
+            raw_inside.append(np.mean(raw < -INSIDE_DEPTH))
+        print(f"| {garment} | {len(pos)} | {placed.seconds['fit']:.1f} | "
+              f"{1000 * placed.fitted.registration_error:.1f} | {1000 * source_distance:.1f} | "
+              f"{1000 * rest_distance:.1f} | {1000 * np.mean(walking):.1f} | "
+              f"{100 * np.mean(inside):.2f} | {100 * np.mean(raw_inside):.2f} | "
+              f"{seconds:.1f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
