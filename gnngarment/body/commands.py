@@ -38,6 +38,23 @@ def write_obj_sequence(
     return paths
 
 
+def write_rest_body(out: Path, rest, faces: np.ndarray) -> None:
+    """``out/rest_body.obj`` (the rest mesh, metres, Z up) and ``out/rest_joints.json``
+    (``{joint name: [x, y, z]}`` metres), each written whole or not at all."""
+    import json
+
+    from gnngarment.body.skeleton import JOINT_NAMES
+    from gnngarment.geometry.files import atomic_write_bytes
+
+    vertices = rest.vertices.numpy()
+    text = ("v %.6f %.6f %.6f\n" * len(vertices)) % tuple(vertices.ravel().tolist())
+    text += ("f %d %d %d\n" * len(faces)) % tuple((np.asarray(faces) + 1).ravel().tolist())
+    atomic_write_bytes(out / "rest_body.obj", text.encode())
+    joints = {name: [round(float(c), 6) for c in position]
+              for name, position in zip(JOINT_NAMES, rest.joints.numpy(), strict=True)}
+    atomic_write_bytes(out / "rest_joints.json", json.dumps(joints, indent=1).encode())
+
+
 def body_command(
     out: Annotated[Path, typer.Option("--out", help="Output folder (created).")],
     motion: Annotated[
@@ -59,8 +76,14 @@ def body_command(
     seed: Annotated[
         int | None, typer.Option("--seed", help="Seeded variation of procedural motions.")
     ] = None,
+    rest: Annotated[
+        bool, typer.Option("--rest", help="Write only the rest body (rest_body.obj, metres, Z "
+                           "up, facing -Y: the frame `animate` expects a garment in) and its "
+                           "joints (rest_joints.json), to dress garments on in other tools.")
+    ] = False,
 ) -> None:
-    """Pose a body by a motion: OBJ sequence + skeleton preview PNG in --out."""
+    """Pose a body by a motion: OBJ sequence + skeleton preview PNG in --out (or, with
+    --rest, the rest body to model garments on)."""
     from rich.console import Console
     from rich.progress import Progress
 
@@ -80,7 +103,8 @@ def body_command(
     if model not in ("anny", "smpl"):
         _fail(f"--model must be 'anny' or 'smpl', got '{model}'")
     try:
-        motion_data = load_motion(motion, fps=fps, duration=duration, seed=seed)
+        motion_data = None if rest else load_motion(motion, fps=fps, duration=duration,
+                                                    seed=seed)
     except MotionError as error:
         _fail(str(error))
     try:
@@ -93,6 +117,11 @@ def body_command(
         out.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         _fail(f"{out}: cannot create the output folder ({error})")
+    if motion_data is None:
+        write_rest_body(out, body.rest(body_shape), body.faces)
+        console.print(f"wrote {out / 'rest_body.obj'} and {out / 'rest_joints.json'} (metres, "
+                      f"Z up, facing -Y) in {time.perf_counter() - start:.1f} s")
+        return
     with console.status(f"posing {motion_data.num_frames} frames"):
         posed = body.pose(motion_data, body_shape)
     vertices = posed.vertices.numpy()

@@ -51,3 +51,27 @@ def test_bad_input_exits_2_without_traceback(tmp_path):
         result = runner.invoke(_app(), args)
         assert result.exit_code == 2, (args, result.output)
         assert "error" in result.output and "Traceback" not in result.output
+
+
+def test_rest_body_is_exactly_the_frame_animate_expects(anny_body, tmp_path):
+    """`body --rest` writes the rest mesh and joints that `animate` dresses a garment on:
+    a garment modelled on that OBJ is in the right frame by construction."""
+    import json
+
+    import numpy as np
+
+    from gnngarment.body.skeleton import JOINT_NAMES
+    from gnngarment.geometry.mesh_io import load_mesh
+
+    out = tmp_path / "rest"
+    result = CliRunner().invoke(_app(), ["body", "--rest", "--shape", "tall_male", "--out",
+                                         str(out)])
+    assert result.exit_code == 0, result.output
+    rest = anny_body.rest(anny_body.parse_shape("tall_male"))
+    vertices, faces = load_mesh(out / "rest_body.obj")
+    np.testing.assert_allclose(vertices, rest.vertices.numpy(), atol=2e-6)
+    np.testing.assert_array_equal(faces, anny_body.faces)
+    joints = json.loads((out / "rest_joints.json").read_text())
+    assert list(joints) == list(JOINT_NAMES)
+    np.testing.assert_allclose(np.array(list(joints.values())), rest.joints.numpy(), atol=2e-6)
+    assert not list(out.glob("body_*.obj"))
