@@ -192,3 +192,19 @@ def test_source_body_with_explicit_placement_or_a_bad_file_exits_2(files, tmp_pa
         result = runner.invoke(app, base + extra)
         assert result.exit_code == 2, (extra, result.output)
         assert message in " ".join(result.output.split()), result.output
+
+
+def test_drape_settles_the_garment_before_animating(files) -> None:
+    """`--drape`: the rest garment written is the settled one (it moved, downwards on
+    average: gravity), and the command says how it went."""
+    out = files["folder"] / "draped"
+    result = runner.invoke(app, ["animate", str(files["garment"]), "--drape", "--checkpoint",
+                                 str(files["checkpoint"]), "--out", str(out), "--duration",
+                                 "0.1", "--format", "pc2", "--no-body"])
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "draped on the rest body" in text
+    given, _ = load_mesh(files["garment"])
+    draped, _ = load_mesh(out / "skirt_rest.obj")
+    assert np.linalg.norm(draped - given, axis=1).mean() > 0.002
+    assert (draped[:, 2] - given[:, 2]).mean() < 0
