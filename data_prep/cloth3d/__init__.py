@@ -9,22 +9,17 @@ metres, radians):
 - sequence folders: :func:`read_sequence`, :func:`write_sequence`,
   :func:`inspect_sequence`, :func:`scan_dataset`
 - frame conventions: :func:`to_world`, :func:`from_world`, :func:`world_transform`,
-  :func:`rest_to_canonical`, :func:`canonical_to_rest`, :func:`z_rotation`
-  (assumed from CLOTH3D's starter kit; unverified on real data, see ``docs/cloth3d.md``)
+  :func:`z_rotation` (measured on a real sequence, see ``docs/cloth3d.md``); rest OBJs
+  are stored canonical and read as they are
+- rest template vs frames: :func:`rest_alignment`, :func:`unroot_frames`,
+  :class:`RestAlignment`
 - errors: :class:`Cloth3DError` (a ``ValueError`` whose message names the file)
 """
 
 from data_prep.cloth3d.atomic import atomic_write
 from data_prep.cloth3d.errors import Cloth3DError
-from data_prep.cloth3d.frames import (
-    canonical_to_rest,
-    from_world,
-    rest_to_canonical,
-    to_world,
-    world_transform,
-    z_rotation,
-)
-from data_prep.cloth3d.info import read_info, write_info
+from data_prep.cloth3d.frames import from_world, to_world, world_transform, z_rotation
+from data_prep.cloth3d.info import GENDER_NAMES, read_info, write_info
 from data_prep.cloth3d.obj_file import write_obj
 from data_prep.cloth3d.point_cache import (
     PointCacheHeader,
@@ -32,6 +27,7 @@ from data_prep.cloth3d.point_cache import (
     read_point_cache_header,
     write_point_cache,
 )
+from data_prep.cloth3d.rest_alignment import RestAlignment, rest_alignment, unroot_frames
 from data_prep.cloth3d.scan import scan_dataset
 from data_prep.cloth3d.sequence import (
     DEFAULT_FPS,
@@ -46,10 +42,10 @@ from data_prep.cloth3d.sequence import (
 )
 
 __all__ = [
-    "DEFAULT_FPS", "GARMENT_NAMES", "Cloth3DError", "Cloth3DGarment", "Cloth3DSequence",
-    "GarmentFiles", "PointCacheHeader", "SequenceLayout", "atomic_write", "canonical_to_rest",
-    "from_world", "inspect_sequence", "read_info", "read_point_cache",
-    "read_point_cache_header", "read_sequence", "rest_to_canonical", "scan_dataset",
-    "to_world", "world_transform", "write_info", "write_obj", "write_point_cache",
+    "DEFAULT_FPS", "GARMENT_NAMES", "GENDER_NAMES", "Cloth3DError", "Cloth3DGarment",
+    "Cloth3DSequence", "GarmentFiles", "PointCacheHeader", "RestAlignment", "SequenceLayout",
+    "atomic_write", "from_world", "inspect_sequence", "read_info", "read_point_cache",
+    "read_point_cache_header", "read_sequence", "rest_alignment", "scan_dataset", "to_world",
+    "unroot_frames", "world_transform", "write_info", "write_obj", "write_point_cache",
     "write_sequence", "z_rotation",
 ]

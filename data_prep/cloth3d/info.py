@@ -34,6 +34,8 @@ from data_prep.cloth3d.errors import Cloth3DError
 #: Fields every CLOTH3D ``info.mat`` has and :func:`read_info` / :func:`write_info` need.
 REQUIRED_FIELDS = ("poses", "trans", "shape", "gender", "zrot", "outfit")
 POSE_SIZE = 72  # 24 SMPL joints × 3 axis-angle components
+#: ``gender`` value → SMPL model: CLOTH3D's starter kit reads ``'m' if gender else 'f'``.
+GENDER_NAMES = ("female", "male")
 #: MATLAB variable and struct field names (scipy's long_field_names allows 63 chars).
 _MATLAB_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,62}")
 

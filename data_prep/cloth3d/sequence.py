@@ -19,8 +19,8 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from data_prep.cloth3d.errors import Cloth3DError
-from data_prep.cloth3d.frames import canonical_to_rest, rest_to_canonical, to_world
-from data_prep.cloth3d.info import normalise_info, read_info, write_info
+from data_prep.cloth3d.frames import to_world
+from data_prep.cloth3d.info import GENDER_NAMES, normalise_info, read_info, write_info
 from data_prep.cloth3d.obj_file import count_obj_vertices, write_obj
 from data_prep.cloth3d.point_cache import (
     FLOAT16_MAX,
@@ -29,6 +29,7 @@ from data_prep.cloth3d.point_cache import (
     read_point_cache_header,
     write_point_cache,
 )
+from data_prep.cloth3d.rest_alignment import RestAlignment, rest_alignment
 
 INFO_FILE = "info.mat"
 #: Garment names in the CLOTH3D release (a folder may use any subset; others are allowed).
@@ -42,7 +43,8 @@ class Cloth3DGarment(NamedTuple):
     """One garment of a sequence; unpacks as ``rest_pos, faces, frames``.
 
     Attributes:
-        rest_pos: ``(N, 3)`` float64 rest mesh in the canonical (unrotated) frame, metres.
+        rest_pos: ``(N, 3)`` float64 rest mesh as stored in the OBJ: canonical (no
+            ``trans``, no ``zrot``; root at the origin, Z up), metres.
         faces: ``(F, 3)`` int64 triangles (quads of the OBJ split).
         frames: ``(T, N, 3)`` float32 positions in the cache frame (root at the origin,
             before ``trans`` and ``zrot``; see :mod:`data_prep.cloth3d.frames`), metres.
@@ -102,6 +104,18 @@ class Cloth3DSequence:
         return self.info["gender"]
 
     @property
+    def gender_name(self) -> str:
+        """``"female"`` or ``"male"``, the SMPL model to pose this sequence with.
+
+        Raises:
+            Cloth3DError: ``gender`` is neither 0 nor 1 (names ``info.mat``).
+        """
+        if self.gender not in (0, 1):
+            raise Cloth3DError(f"{self.folder / INFO_FILE}: gender = {self.gender}, expected "
+                               f"0 (female) or 1 (male)")
+        return GENDER_NAMES[self.gender]
+
+    @property
     def zrot(self) -> float:
         """Rotation of the whole sequence about +z, radians."""
         return self.info["zrot"]
@@ -109,6 +123,13 @@ class Cloth3DSequence:
     def world_frames(self, garment: str) -> np.ndarray:
         """``(T, N, 3)`` float32 world positions of ``garment``: ``R_z(zrot)(x + trans_t)``."""
         return to_world(self.garments[garment].frames, self.trans, self.zrot)
+
+    def rest_alignment(self, garment: str) -> RestAlignment:
+        """How well ``garment``'s rest mesh matches its frames with each frame's root
+        rotation undone (:func:`~data_prep.cloth3d.rest_alignment.rest_alignment`);
+        ``.problem()`` is ``None`` when they are consistent."""
+        rest_pos, _, frames = self.garments[garment]
+        return rest_alignment(rest_pos, frames, self.joint_rotations[:, 0])
 
 
 @dataclass(frozen=True)
@@ -195,9 +216,10 @@ def read_sequence(folder: str | Path, fps: float = DEFAULT_FPS) -> Cloth3DSequen
         fps: frame rate to attach (CLOTH3D does not store one).
 
     Returns:
-        The sequence; rest meshes are rotated back to the canonical frame
-        (``R_z(−zrot)``), frames stay in the cache frame (see
-        :meth:`Cloth3DSequence.world_frames`).
+        The sequence; rest meshes as stored (CLOTH3D stores them canonical: measured on
+        real data, see :mod:`data_prep.cloth3d.frames`), frames in the cache frame (see
+        :meth:`Cloth3DSequence.world_frames`). Nothing checks that the two agree; see
+        :meth:`Cloth3DSequence.rest_alignment`.
 
     Raises:
         Cloth3DError: anything :func:`inspect_sequence` finds, an unreadable OBJ, or an
@@ -209,7 +231,6 @@ def read_sequence(folder: str | Path, fps: float = DEFAULT_FPS) -> Cloth3DSequen
     if not (np.isfinite(fps) and fps > 0):
         raise ValueError(f"fps must be positive, got {fps}")
     layout = inspect_sequence(folder)
-    zrot = layout.info["zrot"]
     garments = {}
     for name, files in layout.garments.items():
         try:
@@ -224,7 +245,7 @@ def read_sequence(folder: str | Path, fps: float = DEFAULT_FPS) -> Cloth3DSequen
                                f"{faces.max() + 1}] (1-based) but there are {len(pos)} "
                                f"vertices")
         frames = read_payload(files.header)
-        garments[name] = Cloth3DGarment(rest_to_canonical(pos, zrot), faces, frames)
+        garments[name] = Cloth3DGarment(pos, faces, frames)
     return Cloth3DSequence(layout.folder.name, layout.folder, layout.info, float(fps), garments)
 
 
@@ -233,7 +254,7 @@ def write_sequence(folder: str | Path, info: Mapping[str, Any],
                    half: bool = True) -> Path:
     """Write a sequence folder in CLOTH3D's layout, each file atomically.
 
-    Writes ``<Garment>.obj`` (rest mesh rotated by ``zrot``, as CLOTH3D stores it),
+    Writes ``<Garment>.obj`` (the canonical rest mesh as given, as CLOTH3D stores it),
     ``<Garment>.pc16`` (or ``.pc2`` with ``half=False``; a stale cache of the other kind
     is removed so the reader never sees two) and, last, ``info.mat``. An existing
     ``info.mat`` is removed before anything else is written, so a folder whose writing
@@ -287,8 +308,7 @@ def write_sequence(folder: str | Path, info: Mapping[str, Any],
         os.unlink(folder / INFO_FILE)
     extension, other = (".pc16", ".pc2") if half else (".pc2", ".pc16")
     for name, (rest_pos, faces, frames) in checked.items():
-        write_obj(folder / f"{name}.obj", canonical_to_rest(rest_pos, normalised["zrot"]),
-                  faces)
+        write_obj(folder / f"{name}.obj", rest_pos, faces)
         write_point_cache(folder / f"{name}{extension}", frames, half=half)
         with contextlib.suppress(FileNotFoundError):
             os.unlink(folder / f"{name}{other}")

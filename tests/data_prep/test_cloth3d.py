@@ -17,16 +17,16 @@ import data_prep.cloth3d.sequence as sequence_module
 from data_prep.cloth3d import (
     Cloth3DError,
     atomic_write,
-    canonical_to_rest,
     from_world,
     inspect_sequence,
     read_info,
     read_point_cache,
     read_point_cache_header,
     read_sequence,
-    rest_to_canonical,
+    rest_alignment,
     scan_dataset,
     to_world,
+    unroot_frames,
     world_transform,
     write_info,
     write_point_cache,
@@ -342,12 +342,57 @@ def test_world_transform_matches_to_world_for_points_and_rigid_transforms() -> N
                                to_world(np.tile(joint[:3, 3], (3, 1)), trans, zrot), atol=1e-12)
 
 
-def test_rest_rotation_round_trip_and_direction() -> None:
+def test_z_rotation_direction() -> None:
     np.testing.assert_allclose(z_rotation(np.pi / 2) @ [1.0, 0, 0], [0, 1, 0], atol=1e-15)
-    pos = np.random.default_rng(5).normal(size=(6, 3))
-    stored = canonical_to_rest(pos, 0.3)
-    np.testing.assert_allclose(stored, pos @ z_rotation(0.3).T)
-    np.testing.assert_allclose(rest_to_canonical(stored, 0.3), pos, atol=1e-12)
+
+
+def posed_about_the_root(rest: np.ndarray, root_rotations: np.ndarray) -> np.ndarray:
+    """``(T, N, 3)``: ``rest`` carried by each frame's root rotation relative to the rest
+    root (+90° about x), as a garment glued to the pelvis would be in the cache frame."""
+    from scipy.spatial.transform import Rotation
+
+    rest_root = Rotation.from_rotvec([np.pi / 2, 0, 0])
+    return np.stack([(Rotation.from_rotvec(r) * rest_root.inv()).apply(rest)
+                     for r in root_rotations])
+
+
+def test_unroot_frames_undoes_the_root_rotation_relative_to_the_rest_root() -> None:
+    rng = np.random.default_rng(3)
+    rest = rng.normal(0, 0.2, (7, 3))
+    roots = rng.normal(0, 1.0, (4, 3))
+    frames = posed_about_the_root(rest, roots)
+    np.testing.assert_allclose(unroot_frames(frames, roots), np.tile(rest, (4, 1, 1)),
+                               atol=1e-12)
+    # The rest pose's own root rotation (+90° about x) leaves a frame where it is.
+    still = unroot_frames(rest[None], np.array([[np.pi / 2, 0, 0]]))[0]
+    np.testing.assert_allclose(still, rest, atol=1e-12)
+
+
+def test_rest_alignment_measures_turn_and_distance() -> None:
+    """A template glued to the root: turn 0 and distance 0. The same template stored
+    turned by −0.5 rad reads as turned +0.5 rad (what maps it back onto the frames);
+    one stored 0.3 m too high reads as 0.3 m away with no turn."""
+    rng = np.random.default_rng(4)
+    rest = rng.normal(0, 0.2, (50, 3))
+    roots = rng.normal(0, 1.0, (6, 3))
+    frames = posed_about_the_root(rest, roots)
+
+    good = rest_alignment(rest, frames, roots)
+    assert good.turn.shape == good.distance.shape == (6,)
+    np.testing.assert_allclose(good.turn, 0, atol=1e-9)
+    assert abs(good.fitted_turn) < 1e-9 and good.median_distance < 1e-9
+    assert good.problem() is None
+
+    turned = rest_alignment(rest @ z_rotation(-0.5).T, frames, roots)
+    np.testing.assert_allclose(turned.turn, 0.5, atol=1e-9)
+    assert turned.fitted_turn == pytest.approx(0.5)
+    assert "turned +29°" in turned.problem()
+    assert turned.problem(max_turn=0.6, max_distance=1.0) is None
+
+    high = rest_alignment(rest + np.array([0, 0, 0.3]), frames, roots)
+    assert high.median_distance == pytest.approx(0.3)
+    assert abs(high.fitted_turn) < 0.05
+    assert "0.30 m (median) from its frames" in high.problem()
 
 
 def test_frame_functions_validate_shapes() -> None:
@@ -355,8 +400,14 @@ def test_frame_functions_validate_shapes() -> None:
         to_world(np.zeros((4, 5, 3)), np.zeros((2, 3)), 0.0)
     with pytest.raises(ValueError, match=r"expected \(T, \.\.\., 3\)"):
         from_world(np.zeros((4, 2)), np.zeros((4, 3)), 0.0)
-    with pytest.raises(ValueError, match=r"expected \(N, 3\)"):
-        rest_to_canonical(np.zeros((4, 3, 3)), 0.0)
+    with pytest.raises(ValueError, match=r"expected \(T, 3\) = \(4, 3\)"):
+        unroot_frames(np.zeros((4, 5, 3)), np.zeros((2, 3)))
+    with pytest.raises(ValueError, match=r"frames have shape \(5, 3\), expected \(T, N, 3\)"):
+        unroot_frames(np.zeros((5, 3)), np.zeros((5, 3)))
+    with pytest.raises(ValueError, match=r"rest_pos has shape \(4, 3, 3\), expected \(N, 3\)"):
+        rest_alignment(np.zeros((4, 3, 3)), np.zeros((1, 4, 3)), np.zeros((1, 3)))
+    with pytest.raises(ValueError, match="frames have 5 vertices but rest_pos has 4"):
+        rest_alignment(np.zeros((4, 3)), np.zeros((1, 5, 3)), np.zeros((1, 3)))
 
 
 # --------------------------------------------------------------------------- sequences
@@ -382,12 +433,13 @@ def test_sequence_round_trip(tmp_path: Path, num_frames: int) -> None:
     assert sequence.joint_rotations.shape == (num_frames, 24, 3)
     for name, (rest_pos, faces, frames) in garments.items():
         got = sequence.garments[name]
-        np.testing.assert_allclose(got.rest_pos, rest_pos, atol=1e-6)  # canonical again
+        np.testing.assert_allclose(got.rest_pos, rest_pos, atol=1e-6)
         np.testing.assert_array_equal(got.faces, faces)
         np.testing.assert_allclose(got.frames, frames, atol=1e-3)  # float16
-        # On disk the rest mesh is rotated by zrot, as CLOTH3D stores it.
+        # On disk the rest mesh is canonical, zrot not applied, as CLOTH3D stores it
+        # (measured on a real sequence: tests/data_prep/test_cloth3d_real_sample.py).
         stored, _ = load_mesh(folder / f"{name}.obj")
-        np.testing.assert_allclose(stored, rest_pos @ z_rotation(0.9).T, atol=1e-6)
+        np.testing.assert_allclose(stored, rest_pos, atol=1e-6)
         np.testing.assert_allclose(sequence.world_frames(name),
                                    to_world(got.frames, sequence.trans, 0.9), atol=1e-6)
     # The result writes back unchanged (a Cloth3DGarment unpacks as the writer's tuple).
@@ -399,11 +451,11 @@ def test_sequence_round_trip(tmp_path: Path, num_frames: int) -> None:
 
 
 def test_reads_cloth3d_style_quads_and_uvs(tmp_path: Path) -> None:
-    # A CLOTH3D-like rest OBJ: quads with UV indices, stored rotated by zrot.
+    # A CLOTH3D-like rest OBJ: quads with UV indices, stored canonical (zrot is for the
+    # world frame only and must not turn it).
     zrot = np.pi / 2
     canonical = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0], [2, 1, 0.]])
-    stored = canonical @ z_rotation(zrot).T
-    lines = [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in stored]
+    lines = [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in canonical]
     lines += ["vt 0 0", "vt 1 0", "vt 1 1", "vt 0 1", "f 1/1 2/2 3/3 4/4", "f 2/1 5/2 6/3 3/4"]
     (tmp_path / "Dress.obj").write_text("\n".join(lines) + "\n")
     frames = np.tile(canonical, (2, 1, 1))
