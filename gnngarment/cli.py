@@ -67,6 +67,10 @@ def inspect(
     levels: Annotated[int | None, typer.Option(help="Pooling levels (default: config).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print everything as JSON.")] = False,
     config: Annotated[Path | None, typer.Option(help="Garment YAML config.")] = None,
+    rest_check: Annotated[bool, typer.Option(
+        help="Simulate a few frames of the garment on the (average) rest body and say "
+             "whether it is at rest (animate expects it draped; else use animate --drape).")
+    ] = False,
 ) -> None:
     """Validate a garment mesh and print its pooling hierarchy and style descriptor."""
     from gnngarment.geometry.errors import MeshError
@@ -82,6 +86,7 @@ def inspect(
     except MeshError as error:
         raise fail(str(error)) from None
     seconds = {"load": load_seconds, **prepared.seconds}
+    rest_state = _rest_state(pos, faces, garment_mesh) if rest_check else None
     hierarchy = prepared.hierarchy
     # Each component's centre at every level, in that level's numbering.
     centres = [level.centres.tolist() for level in hierarchy.levels]
@@ -101,6 +106,7 @@ def inspect(
             ],
             "descriptor": prepared.descriptor.tolist(),
             "seconds": seconds,
+            **({"rest_check": rest_state} if rest_state is not None else {}),
         }
         print(json.dumps(result, indent=2))
         return
@@ -130,6 +136,38 @@ def inspect(
     console.print(f"style descriptor ({len(descriptor)} Nyström eigenvalues, largest first): "
                   + " ".join(f"{v:.4g}" for v in descriptor[:8]) + " ...")
     console.print("seconds: " + ", ".join(f"{k} {v:.3f}" for k, v in seconds.items()))
+    if rest_state is not None:
+        colour = "green" if rest_state["at_rest"] else "yellow"
+        console.print(f"[{colour}]rest check:[/] {rest_state['message']}")
+
+
+#: ``inspect --rest-check``: frames simulated, and the mean move (metres) above which
+#: the garment is "not at rest" (a draped garment creeps ~1 mm in that time).
+REST_CHECK_FRAMES = 5
+REST_CHECK_MOVE = 0.003
+
+
+def _rest_state(pos, faces, garment_mesh: Path) -> dict:
+    """Simulate :data:`REST_CHECK_FRAMES` frames of the garment on the average rest
+    body (as given: metres, Z up) and report how far it moves."""
+    from data_prep.simulate import SimulationFailed, drape_garment
+    from gnngarment.body import AnnyBodyModel
+
+    body_model = AnnyBodyModel()
+    rest = body_model.rest(body_model.default_shape())
+    try:
+        result = drape_garment(pos, faces, rest.vertices.numpy(), body_model.faces,
+                               max_frames=REST_CHECK_FRAMES)
+    except (ValueError, SimulationFailed) as error:
+        raise fail(f"{garment_mesh}: the rest check could not simulate it: {error}") from None
+    move = result.mean_displacement
+    at_rest = move < REST_CHECK_MOVE
+    message = (f"{REST_CHECK_FRAMES} simulated frames on the rest body move it "
+               f"{1000 * move:.1f} mm (mean): "
+               + ("at rest" if at_rest else "not at rest: drape it first (animate --drape, "
+                  "or your simulator)"))
+    return {"at_rest": bool(at_rest), "mean_move_m": move, "frames": REST_CHECK_FRAMES,
+            "message": message}
 
 
 @app.command()

@@ -208,3 +208,15 @@ def test_drape_settles_the_garment_before_animating(files) -> None:
     draped, _ = load_mesh(out / "skirt_rest.obj")
     assert np.linalg.norm(draped - given, axis=1).mean() > 0.002
     assert (draped[:, 2] - given[:, 2]).mean() < 0
+
+
+def test_inspect_says_an_undraped_garment_is_not_at_rest(files) -> None:
+    """The flared skirt design (never simulated) sags as soon as it is simulated on the
+    rest body: `inspect --rest-check` says it is not at rest and points to --drape."""
+    import json
+
+    result = runner.invoke(app, ["inspect", str(files["garment"]), "--rest-check", "--json"])
+    assert result.exit_code == 0, result.output
+    state = json.loads(result.output[result.output.index("{"):])["rest_check"]
+    assert state["at_rest"] is False and state["mean_move_m"] > 0.003
+    assert "animate --drape" in state["message"]
