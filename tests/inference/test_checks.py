@@ -164,3 +164,29 @@ def test_explicit_scale_and_offset(body, garment) -> None:
 def test_explicit_placement_is_validated(garment, options, problem) -> None:
     with pytest.raises(ValueError, match=problem):
         fix_placement(garment[0], **options)
+
+
+REAL_GARMENTS = (__import__("pathlib").Path(__file__).resolve().parents[2].parent / "shared"
+                 / "real-world" / "garments")
+#: The real garments modelled Y up (../shared/real-world/README.md).
+Y_UP_GARMENTS = ("snug_tank", "snug_shorts", "snug_long_sleeve_top", "vto_dress", "ncs_tshirt",
+                 "ncs_pants", "ncs_mannequin_tshirt", "diffcloth_skirt3448",
+                 "diffcloth_dress_v5k")
+
+
+@pytest.mark.skipif(not REAL_GARMENTS.is_dir(), reason="../shared/real-world is absent "
+                    "(third-party test data beside the repository, not in a clone)")
+def test_up_axis_of_real_garments_made_on_other_bodies(anny_rest) -> None:
+    """Every Y-up garment of the real-world set is recognised as Y up on our body, and
+    the Z-up ones (PBNS, CLOTH3D) are left alone, although SMPL-made garments intersect
+    our body more once turned (it is another body)."""
+    from gnngarment.geometry.mesh_io import load_mesh
+    from gnngarment.inference.checks import UNIT_SCALES, detect_up_axis
+
+    body = anny_rest.vertices.numpy().astype(np.float64), anny_rest.faces
+    found = {}
+    for path in sorted(REAL_GARMENTS.glob("*.obj")):
+        pos, _ = load_mesh(path)
+        pos = pos * UNIT_SCALES[detect_units(pos, body[0]) or "m"]
+        found[path.stem] = detect_up_axis(pos, *body)
+    assert found == {name: "y" if name in Y_UP_GARMENTS else "z" for name in found}, found
