@@ -475,6 +475,10 @@ def animate(
     except MeshError as error:
         raise fail(str(error)) from None
     bar.close()
+    if animation.welded:
+        console.print(f"[yellow]welded:[/] {animation.welded} of {len(pos)} vertices coincide "
+                      "with another (one per triangle corner or seam side); the network ran "
+                      "on the welded mesh, the exports keep the file's vertex order")
     animation.uv, animation.uv_faces = uv, uv_faces  # the exports carry the input's UVs
     stages: dict[str, tqdm] = {}
 

@@ -15,6 +15,7 @@ from gnngarment.data.vertex_features import garment_vertex_features
 from gnngarment.geometry import body_collisions
 from gnngarment.geometry.body_collisions import CollisionSettings, CollisionStats
 from gnngarment.geometry.prepare import GarmentPreparationConfig, PreparedGarment, prepare_garment
+from gnngarment.geometry.welding import weld_vertices
 from gnngarment.model.deformer import GarmentDeformer
 
 
@@ -61,6 +62,10 @@ class Animation:
     #: ``None``; the exporters write them (OBJ ``vt``, glb ``TEXCOORD_0``).
     uv: np.ndarray | None = None
     uv_faces: np.ndarray | None = None
+    #: Input vertices merged into a coincident one for the network
+    #: (:func:`~gnngarment.geometry.welding.weld_vertices`: STL exports, UV-split OBJs);
+    #: every array above is in the input's vertex order, copies moving as one.
+    welded: int = 0
 
 
 def garment_pair(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,
@@ -133,9 +138,14 @@ def animate(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray, body: Bo
 
     model.eval()
     settings = collisions or CollisionSettings()
+    given_pos, given_faces = np.asarray(pos), np.asarray(faces, dtype=np.int64)
+    validate_mesh(given_pos, given_faces, source)
+    # Coincident vertices (one per triangle corner in an STL) would make the graph
+    # network see triangle soup: it runs on the welded mesh, the copies follow it.
+    welded = weld_vertices(given_pos, given_faces)
+    pos, faces = welded.pos, welded.faces
     rest, rest_stats, collision_seconds = np.asarray(pos), None, 0.0
     if resolve_collisions:
-        validate_mesh(rest, faces, source)
         started = time.perf_counter()
         rest, rest_stats = body_collisions.resolve_collisions(
             rest, faces, body.rest_vertices, body.faces, settings)
@@ -171,12 +181,22 @@ def animate(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray, body: Bo
         resolved, stats = body_collisions.resolve_collisions(
             raw_posed, faces, frames.vertices, body.faces, settings)
         collision_seconds += time.perf_counter() - started
+    # Back to the input's vertex order (no copy when nothing was welded, so that
+    # ``posed is raw_posed`` stays true with the resolution off).
+    weights_all, blend_all = torch.cat(weights).numpy(), torch.cat(blend).numpy()
+    rest = np.asarray(rest, dtype=np.float32)
+    if welded.merged:
+        index = welded.index
+        same = resolved is raw_posed
+        raw_posed = raw_posed[:, index]
+        resolved = raw_posed if same else resolved[:, index]
+        weights_all, blend_all, rest = weights_all[:, index], blend_all[:, index], rest[index]
     return Animation(
-        rest_pos=np.asarray(rest, dtype=np.float32), faces=np.asarray(faces, dtype=np.int64),
-        posed=resolved, weights=torch.cat(weights).numpy(),
-        blend_shapes=torch.cat(blend).numpy(), joint_transforms=frames.joint_transforms,
+        rest_pos=rest, faces=given_faces, posed=resolved, weights=weights_all,
+        blend_shapes=blend_all,
+        joint_transforms=frames.joint_transforms,
         rest_joints=body.joints, body_vertices=frames.vertices, body_faces=body.faces,
         fps=frames.fps, seconds={"context": context_seconds, "frames": frames_seconds,
                                  "collisions": collision_seconds},
-        raw_posed=raw_posed, raw_rest_pos=np.asarray(pos, dtype=np.float32), collisions=stats,
-        rest_collisions=rest_stats)
+        raw_posed=raw_posed, raw_rest_pos=np.asarray(given_pos, dtype=np.float32),
+        collisions=stats, rest_collisions=rest_stats, welded=welded.merged)

@@ -82,3 +82,19 @@ def test_resolution_can_be_turned_off(scene) -> None:
                    scene["frames"], collisions=CollisionSettings(epsilon=0.01))
     assert signed_distance(wide.rest_pos, scene["body"].rest_vertices,
                            scene["body"].faces).min() >= 0.01 * 0.999
+
+
+def test_triangle_soup_is_animated_as_the_welded_mesh(scene) -> None:
+    """An STL-style garment (every triangle its own three vertices) gives exactly the
+    animation of the welded mesh, in the file's vertex order, copies moving as one."""
+    body, frames = scene["body"], scene["frames"]
+    pos, faces = scene["pos"], scene["faces"]
+    soup_pos = pos[faces.reshape(-1)]
+    soup_faces = np.arange(len(soup_pos)).reshape(-1, 3)
+    welded = animate(scene["model"], pos, faces, body, frames)
+    soup = animate(scene["model"], soup_pos, soup_faces, body, frames)
+    assert soup.welded == len(soup_pos) - len(pos)
+    assert welded.welded == 0
+    np.testing.assert_array_equal(soup.faces, soup_faces)
+    np.testing.assert_allclose(soup.posed, welded.posed[:, faces.reshape(-1)], atol=1e-6)
+    np.testing.assert_allclose(soup.weights, welded.weights[:, faces.reshape(-1)], atol=1e-6)
