@@ -359,6 +359,25 @@ def _load_body_and_motion(body_shape: str, motion: str, fps: float, duration: fl
     return body_model, shape, motion_value
 
 
+def _export_name(garment_mesh: Path) -> str:
+    """The export file stem: the garment file's, with anything but letters, digits and
+    ``-_.`` replaced by ``_`` (``my dress.obj`` → ``my_dress``)."""
+    name = "".join(c if c.isalnum() or c in "-_." else "_" for c in garment_mesh.stem)
+    return name.lstrip(".") or "garment"
+
+
+def _check_output_folder(out: Path) -> None:
+    """Before any work: ``out`` can be created and written, and no other export holds
+    it (the export takes the same lock again while it writes)."""
+    from gnngarment.geometry.files import FolderLock
+
+    try:
+        with FolderLock(out, "export"):
+            pass
+    except OSError as error:
+        raise fail(f"--out {out}: {error}") from None
+
+
 def _drape(placed, faces, body_inputs, garment_mesh: Path):
     """``animate --drape``: the garment settled on the rest body, with a progress bar, or
     a clear failure."""
@@ -433,6 +452,7 @@ def animate(
 
     if not (fps > 0 and fps != float("inf")):  # also NaN; checked before any loading
         raise fail(f"--fps must be a finite number > 0, got {fps}")
+    _check_output_folder(out)
     checkpoint = checkpoint or SHIPPED_MODEL
     try:
         model = load_model(checkpoint)
@@ -489,9 +509,10 @@ def animate(
 
     try:
         paths = export_animation(
-            animation, out, garment_mesh.stem, formats=[f.strip() for f in formats.split(",")],
-            include_body=body, max_influences=influences, progress=exported)
-    except ValueError as error:
+            animation, out, _export_name(garment_mesh),
+            formats=[f.strip() for f in formats.split(",")], include_body=body,
+            max_influences=influences, progress=exported)
+    except (ValueError, OSError) as error:
         raise fail(str(error)) from None
     for stage_bar in stages.values():
         stage_bar.close()

@@ -220,3 +220,25 @@ def test_inspect_says_an_undraped_garment_is_not_at_rest(files) -> None:
     state = json.loads(result.output[result.output.index("{"):])["rest_check"]
     assert state["at_rest"] is False and state["mean_move_m"] > 0.003
     assert "animate --drape" in state["message"]
+
+
+def test_an_unusable_output_folder_is_refused_before_any_work(files, tmp_path) -> None:
+    existing = tmp_path / "a_file"
+    existing.write_text("mine")
+    result = runner.invoke(app, ["animate", str(files["garment"]), "--checkpoint",
+                                 str(files["checkpoint"]), "--out", str(existing)])
+    assert result.exit_code == 2, result.output
+    assert f"--out {existing}" in " ".join(result.output.split())
+    assert "animated" not in result.output and existing.read_text() == "mine"
+
+
+def test_a_file_name_with_a_space_exports(files, tmp_path) -> None:
+    import shutil
+
+    spaced = tmp_path / "my skirt.obj"
+    shutil.copy(files["garment"], spaced)
+    result = runner.invoke(app, ["animate", str(spaced), "--checkpoint", str(files["checkpoint"]),
+                                 "--out", str(tmp_path / "o"), "--duration", "0.1", "--format",
+                                 "pc2", "--no-body"])
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / "o" / "my_skirt.pc2").is_file()

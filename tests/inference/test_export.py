@@ -52,7 +52,9 @@ def test_everything_lands_in_one_documented_layout(animation, tmp_path: Path) ->
     assert manifest["glb"]["start_time_s"] == 0.0 and manifest["uv"] is False
     assert manifest["glb"]["max_error_mm"] < 1e-3
     assert manifest["files"]["gif"] == "skirt.gif"
-    assert not [p for p in out.rglob(".*")]  # no temporary files left behind
+    # No temporary files left behind; the folder lock's (empty once released) `.lock`
+    # stays, as flock locks must (deleting it would let two runs lock two files).
+    assert [p.name for p in out.rglob(".*")] == [".lock"]
 
 
 def test_subset_without_body(animation, tmp_path: Path) -> None:
@@ -133,3 +135,40 @@ def test_input_uvs_reach_the_garment_objs_and_the_glb(tmp_path: Path) -> None:
     assert "TEXCOORD_0" in primitive["attributes"]
     manifest = json.loads(paths["manifest"].read_text())
     assert manifest["uv"] is True and manifest["glb"]["seam_vertices"] == 8
+
+
+def test_a_shorter_rerun_leaves_no_frames_of_the_previous_export(animation,
+                                                                 tmp_path: Path) -> None:
+    """Frames of an earlier, longer export into the same folder (listed by its manifest)
+    go; a file of the user's in that folder stays."""
+    from dataclasses import replace
+
+    export_animation(animation, tmp_path, "skirt", formats=("obj",))
+    folder = tmp_path / "skirt_obj"
+    (folder / "notes.txt").write_text("mine")
+    short = replace(animation, posed=animation.posed[:2], body_vertices=animation.body_vertices[:2],
+                    weights=animation.weights[:2], blend_shapes=animation.blend_shapes[:2],
+                    joint_transforms=animation.joint_transforms[:2])
+    export_animation(short, tmp_path, "skirt", formats=("obj",))
+    assert sorted(p.name for p in folder.glob("garment_*.obj")) == ["garment_0000.obj",
+                                                                    "garment_0001.obj"]
+    assert sorted(p.name for p in folder.glob("body_*.obj")) == ["body_0000.obj",
+                                                                 "body_0001.obj"]
+    assert (folder / "notes.txt").read_text() == "mine"
+
+
+def test_a_second_export_into_a_busy_folder_is_refused_and_stale_temporaries_go(
+        animation, tmp_path: Path) -> None:
+    from gnngarment.geometry.files import FolderBusyError, FolderLock
+
+    with FolderLock(tmp_path, "export"), pytest.raises(FolderBusyError, match="another export"):
+        export_animation(animation, tmp_path, "skirt", formats=("pc2",))
+    assert not (tmp_path / "skirt.pc2").exists()
+    # A killed export's temporary file (atomic_write's name pattern) and a user's file.
+    (tmp_path / "skirt_obj").mkdir()
+    killed = tmp_path / "skirt_obj" / ".garment_0000.obj.0123abcd.tmp"
+    killed.write_bytes(b"x" * 100)
+    draft = tmp_path / ".draft.tmp"
+    draft.write_text("mine")
+    export_animation(animation, tmp_path, "skirt", formats=("obj",))
+    assert not killed.exists() and draft.read_text() == "mine"

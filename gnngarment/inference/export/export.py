@@ -26,9 +26,10 @@ from numbers import Integral
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from gnngarment.geometry.files import FolderLock
 from gnngarment.inference.export.atomic import atomic_write_bytes
 from gnngarment.inference.export.gltf import write_glb
-from gnngarment.inference.export.obj_sequence import write_obj, write_obj_sequence
+from gnngarment.inference.export.obj_sequence import frame_path, write_obj, write_obj_sequence
 from gnngarment.inference.export.point_cache import write_point_cache
 from gnngarment.inference.export.preview import render_preview
 from gnngarment.inference.export.validation import check_animation
@@ -85,7 +86,46 @@ def export_animation(animation: Animation, out_dir: str | Path, name: str,
         raise ValueError(f"first_frame must be an integer ≥ 0, got {first_frame!r}")
     check_animation(animation, body=include_body)
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    # One export per folder at a time (a second is refused, naming the holder), and the
+    # temporary files a killed earlier export left behind are removed first.
+    with FolderLock(out, "export") as lock:
+        lock.remove_stale_temporaries((".", f"{name}_obj"))
+        previous = _previous_frames(out / f"{name}_export.json")
+        paths = _export(animation, out, name, formats, include_body, progress, first_frame,
+                        max_influences, morph_interpolation, preview_size, preview_max_frames)
+        if "obj" in formats and previous is not None:
+            _remove_stale_frames(paths["obj"], previous, first_frame, len(animation.posed))
+    return paths
+
+
+def _previous_frames(manifest: Path) -> tuple[int, int] | None:
+    """(first frame, frame count) of the export whose manifest is ``manifest``, or
+    ``None`` (no manifest, or not one of ours)."""
+    try:
+        data = json.loads(manifest.read_text())
+        return int(data["first_frame"]), int(data["frames"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def _remove_stale_frames(folder: Path, previous: tuple[int, int], first_frame: int,
+                         frames: int) -> None:
+    """Delete the per-frame OBJs a previous export (per its manifest) wrote that this one
+    did not overwrite — a shorter re-run would otherwise leave its old extra frames."""
+    start, count = previous
+    digits = max(4, len(str(start + count - 1)))
+    kept = range(first_frame, first_frame + frames)
+    for frame in range(start, start + count):
+        if frame in kept:
+            continue
+        for stem in ("garment", "body"):
+            frame_path(folder, stem, frame, digits).unlink(missing_ok=True)
+
+
+def _export(animation: Animation, out: Path, name: str, formats, include_body: bool,
+            progress: Progress | None, first_frame: int, max_influences: int,
+            morph_interpolation: str, preview_size: int, preview_max_frames: int
+            ) -> dict[str, Path]:
     frames = len(animation.posed)
     paths: dict[str, Path] = {}
     manifest: dict = {
