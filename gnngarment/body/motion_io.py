@@ -1,12 +1,14 @@
-"""Reading motions from files: AMASS ``.npz``, BVH (CMU naming), CLOTH3D ``info.mat``.
+"""Reading motions from files: AMASS and NCS-style SMPL ``.npz``, BVH, CLOTH3D ``info.mat``.
 
 All loaders return a canonical :class:`~gnngarment.body.motion.Motion` (Z up, T-pose
 rest, world-aligned local axes; see :mod:`gnngarment.body.skeleton`). SMPL-convention
 data (AMASS, CLOTH3D) has Y-up joint axes but a Z-up world (its root rotation includes
 the +90° turn about X); it is converted by ``R'_j = C R_j Cᵀ`` for ``j ≥ 1`` and
-``R'_0 = R_0 Cᵀ`` with ``C = Rx(+90°)``, which leaves world positions unchanged. BVH
-(Y-up world and axes) is converted by ``C R_j Cᵀ`` for every joint and ``C t`` for the
-translation.
+``R'_0 = R_0 Cᵀ`` with ``C = Rx(+90°)``, which leaves world positions unchanged.
+SMPL data in a Y-up world (NCS-style ``.npz``) is converted by ``C R_j Cᵀ`` for every
+joint and ``C t`` for the translation. BVH files (name table, rest-pose retargeting,
+units) are read by :mod:`gnngarment.body.bvh_motion`; its public names are re-exported
+here. Supported formats: ``docs/motions.md``.
 
 Translation: by default the first frame's root translation is subtracted, so every
 loaded motion starts with the pelvis at its rest position (``relative_translation``).
@@ -14,20 +16,45 @@ loaded motion starts with the pelvis at its rest position (``relative_translatio
 
 from __future__ import annotations
 
-import warnings
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 
+from gnngarment.body.bvh_motion import (
+    BVH_JOINT_CANDIDATES,
+    BVH_OPTIONAL_JOINTS,
+    DEFAULT_REST_JOINTS,
+    UnmappedJointsWarning,
+    load_bvh_motion,
+    map_bvh_joints,
+    normalize_joint_name,
+    read_joint_map,
+)
 from gnngarment.body.motion import Motion, MotionError
-from gnngarment.body.skeleton import JOINT_NAMES, JOINT_PARENTS, NUM_JOINTS
+from gnngarment.body.skeleton import NUM_JOINTS
+
+__all__ = [
+    "BVH_JOINT_CANDIDATES",
+    "BVH_OPTIONAL_JOINTS",
+    "DEFAULT_REST_JOINTS",
+    "MOTION_FILE_TYPES",
+    "SMPL_TO_CANONICAL",
+    "UnmappedJointsWarning",
+    "load_amass_motion",
+    "load_bvh_motion",
+    "load_cloth3d_motion",
+    "load_motion",
+    "load_npz_motion",
+    "map_bvh_joints",
+    "motion_from_smpl",
+    "normalize_joint_name",
+    "read_cloth3d_info",
+    "read_joint_map",
+]
 
 # SMPL (Y-up) body axes → canonical (Z-up) axes: a +90° rotation about X.
 SMPL_TO_CANONICAL = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
-
-
-class UnmappedJointsWarning(UserWarning):
-    """Joints of a motion file that are not mapped onto the canonical skeleton."""
 
 
 def motion_from_smpl(
@@ -76,13 +103,18 @@ def motion_from_smpl(
     return Motion(rotations.reshape(-1, NUM_JOINTS, 3), translation, fps, name)
 
 
-def load_amass_motion(path: str | Path, relative_translation: bool = True) -> Motion:
+def load_amass_motion(
+    path: str | Path, relative_translation: bool = True, up_axis: str = "z"
+) -> Motion:
     """An AMASS ``.npz``: ``poses`` (T, 72 | 156 | 165), ``trans`` (T, 3), frame rate in
     ``mocap_framerate`` (or ``mocap_frame_rate``).
 
     The 22 body joints are the first 66 values. SMPL's two hand joints are the next 6
     values only for 72-wide (SMPL) poses; for SMPL-H (156) and SMPL-X (165) those values
     are finger/jaw/eye rotations, so the hands are left at rest.
+
+    Args:
+        up_axis: the world's up axis, ``"z"`` (AMASS) or ``"y"``.
     """
     path = Path(path)
     if not path.is_file():
@@ -90,7 +122,8 @@ def load_amass_motion(path: str | Path, relative_translation: bool = True) -> Mo
     try:
         data = np.load(path, allow_pickle=False)
     except Exception as error:
-        raise MotionError(f"{path}: not a readable .npz file ({error})") from error
+        message = " ".join(str(error).split())
+        raise MotionError(f"{path}: not a readable .npz file ({message})") from error
     for key in ("poses", "trans"):
         if key not in data:
             raise MotionError(f"{path}: AMASS file has no '{key}' array (keys: {list(data)})")
@@ -106,7 +139,107 @@ def load_amass_motion(path: str | Path, relative_translation: bool = True) -> Mo
     if not np.isfinite(fps) or fps <= 0:
         raise MotionError(f"{path}: mocap frame rate must be > 0, got {fps}")
     return motion_from_smpl(
-        body, data["trans"], fps, str(path), relative_translation=relative_translation
+        body,
+        data["trans"],
+        fps,
+        str(path),
+        world_y_up=_world_y_up(up_axis, path),
+        relative_translation=relative_translation,
+    )
+
+
+def _world_y_up(up_axis: str, path: Path) -> bool:
+    if up_axis not in ("y", "z"):
+        raise MotionError(f"{path}: up_axis must be 'auto', 'y' or 'z', got {up_axis!r}")
+    return up_axis == "y"
+
+
+_SUPPORTED_NPZ = (
+    "AMASS (poses (T, 72|156|165), trans (T, 3), mocap_framerate; Z-up world) or NCS-style "
+    "SMPL (poses (T, 24, 3) or (T, 72), trans (T, 3), fps; Y-up world)"
+)
+
+
+def load_npz_motion(
+    path: str | Path, up_axis: str = "auto", relative_translation: bool = True
+) -> Motion:
+    """An SMPL motion ``.npz``: AMASS or NCS-style, told apart by the keys.
+
+    * AMASS: ``poses`` (T, 72 | 156 | 165), ``trans`` (T, 3), ``mocap_framerate``; Z-up
+      world (:func:`load_amass_motion`).
+    * NCS-style: ``poses`` (T, 24, 3) or (T, 72) SMPL axis-angles (SMPL-H/X widths 156/165
+      give their 22 body joints), ``trans`` (T, 3), ``fps``; Y-up world (the SMPL body
+      stands upright with a zero root rotation).
+
+    Args:
+        up_axis: ``"auto"`` (Z for AMASS, Y for NCS-style), ``"y"`` or ``"z"``.
+
+    Raises:
+        MotionError: a rig that is not SMPL (e.g. Mixamo quaternions on 65 joints), a
+            missing key, bad shapes or values; one line naming the file.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise MotionError(f"{path}: file not found")
+    if up_axis not in ("auto", "y", "z"):
+        raise MotionError(f"{path}: up_axis must be 'auto', 'y' or 'z', got {up_axis!r}")
+    try:
+        data = np.load(path, allow_pickle=False)
+        keys = list(data.files)
+        arrays = {key: data[key] for key in keys}
+    except Exception as error:
+        message = " ".join(str(error).split())
+        raise MotionError(f"{path}: not a readable .npz file ({message})") from error
+    if "poses" not in arrays:
+        raise MotionError(
+            f"{path}: no 'poses' array (keys: {', '.join(keys) or 'none'}); supported .npz "
+            f"motions: {_SUPPORTED_NPZ}"
+        )
+    poses = arrays["poses"]
+    if poses.ndim == 3 and (poses.shape[2] == 4 or poses.shape[1] != 24):
+        kind = "quaternions" if poses.shape[2] == 4 else f"{poses.shape[2]}-vectors"
+        origin = arrays.get("source")
+        origin = f" (source {str(origin)!r})" if origin is not None and origin.ndim == 0 else ""
+        raise MotionError(
+            f"{path}: 'poses' {poses.shape} holds {kind} on a {poses.shape[1]}-joint rig"
+            f"{origin}, not SMPL's 24 axis-angle joints; supported .npz motions: "
+            f"{_SUPPORTED_NPZ}; for another rig export it as BVH and load that "
+            "(--joint-map FILE for unusual joint names)"
+        )
+    fps_key = next((k for k in ("mocap_framerate", "mocap_frame_rate") if k in arrays), None)
+    if fps_key is not None:
+        return load_amass_motion(
+            path, relative_translation, up_axis="z" if up_axis == "auto" else up_axis
+        )
+    if "fps" not in arrays:
+        raise MotionError(
+            f"{path}: no frame rate: expected 'mocap_framerate' (AMASS) or 'fps' (NCS-style)"
+            f" (keys: {', '.join(keys)})"
+        )
+    if "trans" not in arrays:
+        raise MotionError(f"{path}: NCS-style file has no 'trans' array (keys: {', '.join(keys)})")
+    if poses.ndim == 2 and poses.shape[1] in (156, 165):  # SMPL-H/X: body joints only
+        body = np.zeros((poses.shape[0], 72))
+        body[:, :66] = poses[:, :66]
+        poses = body
+    if not (poses.ndim == 3 and poses.shape[1:] == (24, 3)) and not (
+        poses.ndim == 2 and poses.shape[1] == 72
+    ):
+        raise MotionError(f"{path}: NCS-style 'poses' must be (T, 24, 3) or (T, 72), got "
+                          f"{poses.shape}")  # fmt: skip
+    try:
+        fps = float(np.asarray(arrays["fps"], dtype=np.float64).reshape(-1)[0])
+    except (TypeError, ValueError, IndexError) as error:
+        raise MotionError(f"{path}: 'fps' must be a number, got {arrays['fps']!r}") from error
+    if not np.isfinite(fps) or fps <= 0:
+        raise MotionError(f"{path}: 'fps' must be > 0, got {fps}")
+    return motion_from_smpl(
+        np.asarray(poses, dtype=np.float64),
+        np.asarray(arrays["trans"], dtype=np.float64),
+        fps,
+        str(path),
+        world_y_up=_world_y_up("y" if up_axis == "auto" else up_axis, path),
+        relative_translation=relative_translation,
     )
 
 
@@ -181,186 +314,55 @@ def load_cloth3d_motion(
     return motion
 
 
-# Canonical joint → candidate BVH joint names (CMU first, then Mixamo-like), first unused wins.
-BVH_JOINT_CANDIDATES: dict[str, tuple[str, ...]] = {
-    "pelvis": ("Hips", "Pelvis", "Root"),
-    "L_hip": ("LeftUpLeg", "LeftThigh", "LThigh"),
-    "R_hip": ("RightUpLeg", "RightThigh", "RThigh"),
-    "spine1": ("LowerBack", "Spine"),
-    "L_knee": ("LeftLeg", "LeftShin", "LShin"),
-    "R_knee": ("RightLeg", "RightShin", "RShin"),
-    "spine2": ("Spine", "Spine1"),
-    "L_ankle": ("LeftFoot", "LFoot"),
-    "R_ankle": ("RightFoot", "RFoot"),
-    "spine3": ("Spine1", "Spine2", "Chest"),
-    "L_foot": ("LeftToeBase", "LeftToe", "LToe"),
-    "R_foot": ("RightToeBase", "RightToe", "RToe"),
-    "neck": ("Neck",),
-    "L_collar": ("LeftShoulder", "LeftCollar", "LCollar"),
-    "R_collar": ("RightShoulder", "RightCollar", "RCollar"),
-    "head": ("Head",),
-    "L_shoulder": ("LeftArm", "LeftUpArm", "LShldr"),
-    "R_shoulder": ("RightArm", "RightUpArm", "RShldr"),
-    "L_elbow": ("LeftForeArm", "LeftLowArm", "LForeArm"),
-    "R_elbow": ("RightForeArm", "RightLowArm", "RForeArm"),
-    "L_wrist": ("LeftHand", "LHand"),
-    "R_wrist": ("RightHand", "RHand"),
-    "L_hand": ("LeftFingerBase", "LeftHandIndex1", "LeftHandMiddle1"),
-    "R_hand": ("RightFingerBase", "RightHandIndex1", "RightHandMiddle1"),
-}
-# Joints a BVH may lack (left at rest, with a warning); any other missing joint is an error.
-BVH_OPTIONAL_JOINTS = frozenset(
-    {"spine2", "spine3", "neck", "L_collar", "R_collar", "L_foot", "R_foot", "L_hand", "R_hand"}
-)
-_LEG_LENGTH = 0.79  # metres (Anny's default thigh + shin), target of scale="auto"
-
-
-def _bare(name: str) -> str:
-    return name.split(":")[-1]
-
-
-def load_bvh_motion(
-    path: str | Path, scale: float | str = "auto", relative_translation: bool = True
-) -> Motion:
-    """A BVH file (parsed by the PyPI ``bvh`` package) mapped onto the 24 joints.
-
-    Assumes the BVH rest pose (all channels zero) is a T-pose with a Y-up world, as in
-    the CMU conversions. Rotations of unmapped intermediate joints fold into their
-    nearest mapped descendant; unmapped leaves (fingers, end sites) are dropped. Both
-    are listed in an :class:`UnmappedJointsWarning`.
-
-    Args:
-        scale: metres per BVH unit, or ``"auto"`` to make the left leg
-            (knee + ankle offsets) 0.79 m long.
-    """
-    from bvh import Bvh
-    from scipy.spatial.transform import Rotation
-
-    path = Path(path)
-    if not path.is_file():
-        raise MotionError(f"{path}: file not found")
-    try:
-        mocap = Bvh(path.read_text(errors="replace"))
-        names = mocap.get_joints_names()
-        frames = np.asarray(mocap.frames, dtype=np.float64)
-        frame_time = float(mocap.frame_time)
-    except Exception as error:
-        raise MotionError(f"{path}: not a readable BVH file ({error})") from error
-    if not names or frames.ndim != 2 or frames.shape[0] < 1:
-        raise MotionError(f"{path}: BVH file has no joints or no frames")
-    if frame_time <= 0 or not np.isfinite(frame_time):
-        raise MotionError(f"{path}: BVH frame time must be > 0, got {frame_time}")
-    if not np.all(np.isfinite(frames)):
-        raise MotionError(f"{path}: BVH frames contain NaN or infinite values")
-
-    bare = {_bare(n): n for n in names}
-    mapping: dict[str, str] = {}
-    used: set[str] = set()
-    for joint in JOINT_NAMES:
-        for candidate in BVH_JOINT_CANDIDATES[joint]:
-            if candidate in bare and candidate not in used:
-                mapping[joint] = bare[candidate]
-                used.add(candidate)
-                break
-    missing = [j for j in JOINT_NAMES if j not in mapping]
-    required_missing = [j for j in missing if j not in BVH_OPTIONAL_JOINTS]
-    if required_missing:
-        raise MotionError(
-            f"{path}: BVH lacks joints for {', '.join(required_missing)} "
-            f"(looked for {', '.join(BVH_JOINT_CANDIDATES[required_missing[0]])} …)"
-        )
-    unmapped = [n for n in names if _bare(n) not in used]
-    if unmapped or missing:
-        warnings.warn(
-            f"{path}: BVH joints not mapped onto the canonical skeleton: "
-            f"{', '.join(unmapped) or 'none'}; canonical joints left at rest: "
-            f"{', '.join(missing) or 'none'}",
-            UnmappedJointsWarning,
-            stacklevel=2,
-        )
-
-    # Global rotation of every BVH joint per frame, parents first (get_joints_names order).
-    count = frames.shape[0]
-    global_rot: dict[str, np.ndarray] = {}
-    root_position = None
-    try:
-        for name in names:
-            channels = mocap.joint_channels(name)
-            start = mocap.get_joint_channels_index(name)
-            rot_channels = [(i, c[0].upper()) for i, c in enumerate(channels) if "rotation" in c]
-            if rot_channels:
-                order = "".join(axis for _, axis in rot_channels)
-                angles = frames[:, [start + i for i, _ in rot_channels]]
-                local = Rotation.from_euler(order, angles, degrees=True).as_matrix()
-            else:
-                local = np.broadcast_to(np.eye(3), (count, 3, 3))
-            parent = mocap.joint_parent(name)
-            parent_rot = global_rot.get(parent.name) if parent is not None else None
-            global_rot[name] = local if parent_rot is None else parent_rot @ local
-            if name == mapping["pelvis"]:
-                pos = [(i, c[0].upper()) for i, c in enumerate(channels) if "position" in c]
-                if len(pos) != 3:
-                    raise MotionError(f"{path}: BVH root '{name}' has no 3 position channels")
-                xyz = {axis: frames[:, start + i] for i, axis in pos}
-                root_position = np.stack([xyz["X"], xyz["Y"], xyz["Z"]], axis=1)
-    except MotionError:
-        raise
-    except Exception as error:
-        raise MotionError(f"{path}: malformed BVH hierarchy or channels ({error})") from error
-
-    if scale == "auto":
-        leg = sum(np.linalg.norm(mocap.joint_offset(mapping[j])) for j in ("L_knee", "L_ankle"))
-        if leg <= 0:
-            raise MotionError(f"{path}: cannot infer the BVH scale (zero leg length)")
-        scale = _LEG_LENGTH / leg
-    scale = float(scale)
-
-    # Canonical local rotations: R_j = G_parent(j)ᵀ G_j with G of missing joints = parent's.
-    canonical_global = np.empty((count, NUM_JOINTS, 3, 3))
-    local = np.empty((count, NUM_JOINTS, 3, 3))
-    for j, joint in enumerate(JOINT_NAMES):
-        parent = JOINT_PARENTS[j]
-        if joint in mapping:
-            canonical_global[:, j] = global_rot[mapping[joint]]
-        else:
-            canonical_global[:, j] = canonical_global[:, parent]
-        if parent < 0:
-            local[:, j] = canonical_global[:, j]
-        else:
-            local[:, j] = np.swapaxes(canonical_global[:, parent], -1, -2) @ canonical_global[:, j]
-    poses = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_rotvec().reshape(count, NUM_JOINTS, 3)
-    return motion_from_smpl(
-        poses,
-        root_position * scale,
-        1.0 / frame_time,
-        str(path),
-        world_y_up=True,
-        relative_translation=relative_translation,
-    )
-
-
 MOTION_FILE_TYPES = (".npz", ".bvh", ".mat")
 
 
-def load_motion(spec: str | Path, fps: float | None = None, **procedural) -> Motion:
-    """A motion from a procedural-library name or a file (``.npz`` AMASS, ``.bvh``,
-    CLOTH3D ``info.mat``), resampled to ``fps`` when given.
+def load_motion(
+    spec: str | Path,
+    fps: float | None = None,
+    joint_map: Mapping[str, str | None] | str | Path | None = None,
+    up_axis: str = "auto",
+    rest_joints: np.ndarray | None = None,
+    **procedural,
+) -> Motion:
+    """A motion from a procedural-library name or a file, resampled to ``fps`` when given.
 
-    ``procedural`` keyword arguments (duration, speed, amplitude, seed) go to
-    :func:`~gnngarment.body.procedural.make_motion`.
+    Files: ``.npz`` AMASS or NCS-style SMPL (:func:`load_npz_motion`), ``.bvh``
+    (:func:`~gnngarment.body.bvh_motion.load_bvh_motion`), CLOTH3D ``info.mat``
+    (:func:`load_cloth3d_motion`). ``procedural`` keyword arguments (duration, speed,
+    amplitude, seed) go to :func:`~gnngarment.body.procedural.make_motion`.
+
+    Args:
+        joint_map: BVH only: canonical joint → BVH joint names (a mapping or a
+            ``.json``/``.yaml`` file, see ``docs/motions.md``).
+        up_axis: ``.npz``/``.bvh`` only: the file's up axis, ``"auto"``, ``"y"`` or ``"z"``.
+        rest_joints: ``(24, 3)`` T-pose rest joints (metres) of the body the motion will
+            play on, for BVH rest-pose retargeting and units (default: Anny's default
+            shape); other formats are already in the canonical T-pose and ignore it.
 
     Raises:
-        MotionError: unknown name, unreadable file, or ``fps`` not a finite number > 0.
+        MotionError: unknown name, unreadable file, an option the file type does not
+            take, or ``fps`` not a finite number > 0.
     """
     from gnngarment.body.procedural import MOTION_LIBRARY, make_motion
 
     if fps is not None and not (np.isfinite(fps) and fps > 0):
         raise MotionError(f"fps must be a finite number > 0, got {fps}")
+    if up_axis not in ("auto", "y", "z"):
+        raise MotionError(f"{spec}: up_axis must be 'auto', 'y' or 'z', got {up_axis!r}")
     name = str(spec)
-    if name in MOTION_LIBRARY:
-        return make_motion(name, **({} if fps is None else {"fps": fps}), **procedural)
     path = Path(spec)
     suffix = path.suffix.lower()
+    if name in MOTION_LIBRARY or suffix not in (".npz", ".bvh"):
+        # Options a motion of this kind cannot use are errors, not silently ignored.
+        if joint_map is not None:
+            raise MotionError(f"{name}: a joint map applies to .bvh motions only")
+        if up_axis != "auto":
+            raise MotionError(f"{name}: an up axis applies to .npz and .bvh motions only")
+    elif suffix == ".npz" and joint_map is not None:
+        raise MotionError(f"{name}: a joint map applies to .bvh motions only")
+    if name in MOTION_LIBRARY:
+        return make_motion(name, **({} if fps is None else {"fps": fps}), **procedural)
     if suffix not in MOTION_FILE_TYPES:
         raise MotionError(
             f"{path}: unknown motion '{name}': not a procedural motion "
@@ -369,9 +371,11 @@ def load_motion(spec: str | Path, fps: float | None = None, **procedural) -> Mot
     if not path.is_file():
         raise MotionError(f"{path}: file not found")
     if suffix == ".npz":
-        motion = load_amass_motion(path)
+        motion = load_npz_motion(path, up_axis=up_axis)
     elif suffix == ".bvh":
-        motion = load_bvh_motion(path)
+        motion = load_bvh_motion(
+            path, joint_map=joint_map, up_axis=up_axis, rest_joints=rest_joints
+        )
     else:
         motion = load_cloth3d_motion(path)
     return motion.resample(fps) if fps is not None and abs(fps - motion.fps) > 1e-9 else motion

@@ -1,17 +1,15 @@
-import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
 
 from gnngarment.body.motion import MotionError
 from gnngarment.body.motion_io import (
     SMPL_TO_CANONICAL,
-    UnmappedJointsWarning,
     load_amass_motion,
-    load_bvh_motion,
     load_cloth3d_motion,
     load_motion,
+    load_npz_motion,
     motion_from_smpl,
     read_cloth3d_info,
 )
@@ -129,106 +127,115 @@ def test_cloth3d(tmp_path):
         load_cloth3d_motion(tmp_path / "bad.mat")
 
 
-# A CMU-style hierarchy (cgspeed BVH conversion), Y up, T-pose rest.
-_CMU = [
-    ("Hips", None, (0, 0, 0)),
-    ("LHipJoint", "Hips", (0, 0, 0)), ("LeftUpLeg", "LHipJoint", (1.6, -2, 0.8)),
-    ("LeftLeg", "LeftUpLeg", (0, -7, 0)), ("LeftFoot", "LeftLeg", (0, -7, 0)),
-    ("LeftToeBase", "LeftFoot", (0, -0.5, 2)),
-    ("RHipJoint", "Hips", (0, 0, 0)), ("RightUpLeg", "RHipJoint", (-1.6, -2, 0.8)),
-    ("RightLeg", "RightUpLeg", (0, -7, 0)), ("RightFoot", "RightLeg", (0, -7, 0)),
-    ("RightToeBase", "RightFoot", (0, -0.5, 2)),
-    ("LowerBack", "Hips", (0, 0, 0)), ("Spine", "LowerBack", (0, 2, 0)),
-    ("Spine1", "Spine", (0, 2, 0)), ("Neck", "Spine1", (0, 2, 0)), ("Neck1", "Neck", (0, 1, 0)),
-    ("Head", "Neck1", (0, 1, 0)),
-    ("LeftShoulder", "Spine1", (0, 2, 0)), ("LeftArm", "LeftShoulder", (3, 0, 0)),
-    ("LeftForeArm", "LeftArm", (5, 0, 0)), ("LeftHand", "LeftForeArm", (4, 0, 0)),
-    ("LeftFingerBase", "LeftHand", (1, 0, 0)), ("LThumb", "LeftHand", (0.5, 0, 0.5)),
-    ("RightShoulder", "Spine1", (0, 2, 0)), ("RightArm", "RightShoulder", (-3, 0, 0)),
-    ("RightForeArm", "RightArm", (-5, 0, 0)), ("RightHand", "RightForeArm", (-4, 0, 0)),
-    ("RightFingerBase", "RightHand", (-1, 0, 0)),
-]  # fmt: skip
+# ---- NCS-style SMPL .npz and rigs that are not SMPL (issue 13 item 5) --------------------------
+
+MIXAMO_NPZ = (
+    Path(__file__).resolve().parents[2].parent / "shared" / "real-world" / "motions"
+    / "ncs_mixamo_0000.npz"
+)  # fmt: skip
 
 
-def _write_bvh(path, joints=_CMU, frames=None):
-    children = {}
-    for name, parent, _ in joints:
-        children.setdefault(parent, []).append(name)
-    offsets = {name: offset for name, _, offset in joints}
-    order = []
-    lines = []
-
-    def emit(name, depth):
-        pad = "  " * depth
-        keyword = "ROOT" if depth == 0 else "JOINT"
-        lines.append(f"{pad}{keyword} {name}")
-        lines.append(f"{pad}{{")
-        lines.append(f"{pad}  OFFSET {' '.join(map(str, offsets[name]))}")
-        if depth == 0:
-            lines.append(
-                f"{pad}  CHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation"
-            )
-        else:
-            lines.append(f"{pad}  CHANNELS 3 Zrotation Yrotation Xrotation")
-        order.append(name)
-        kids = children.get(name, [])
-        for child in kids:
-            emit(child, depth + 1)
-        if not kids:
-            lines.append(f"{pad}  End Site")
-            lines.append(f"{pad}  {{")
-            lines.append(f"{pad}    OFFSET 0 0 0")
-            lines.append(f"{pad}  }}")
-        lines.append(f"{pad}}}")
-
-    emit(children[None][0], 0)
-    channels = 3 + 3 * len(order)
-    if frames is None:
-        frames = np.zeros((3, channels))
-        frames[:, 1] = 17.0
-        frames[1:, 0] = [5.0, 10.0]
-        column = 3 + 3 * order.index("LeftForeArm")  # its Zrotation channel
-        frames[1:, column] = 30.0
-        column = 3 + 3 * order.index("Neck1") + 2  # Neck1 Xrotation: folds into head
-        frames[1:, column] = 20.0
-    text = (
-        "HIERARCHY\n"
-        + "\n".join(lines)
-        + f"\nMOTION\nFrames: {len(frames)}\nFrame Time: 0.0083333\n"
-    )
-    text += "\n".join(" ".join(f"{v:.6f}" for v in row) for row in frames) + "\n"
-    path.write_text(text)
-    return order
+def _ncs_poses(frames):
+    """NCS-style poses (T, 24, 3): Y-up world, so an upright body has a zero root."""
+    poses = np.zeros((frames, 24, 3))
+    poses[:, JOINT_INDEX["L_knee"]] = [0.5, 0.0, 0.0]
+    poses[:, JOINT_INDEX["L_shoulder"]] = [0.0, 0.0, -0.8]
+    poses[1:, 0] = [0.0, 0.3, 0.0]  # turning about SMPL's Y: the vertical
+    return poses
 
 
-def test_bvh_cmu(tmp_path):
-    path = tmp_path / "01_01.bvh"
-    _write_bvh(path)
-    with pytest.warns(UnmappedJointsWarning, match="LHipJoint.*Neck1|Neck1.*LHipJoint") as record:
-        motion = load_bvh_motion(path)
-    assert "LThumb" in str(record[0].message)
-    assert motion.fps == pytest.approx(120.0, rel=1e-3) and motion.num_frames == 3
-    assert np.allclose(motion.rotations[0], 0, atol=1e-12)
-    # BVH Z (front) is canonical −Y: 30° about BVH Z on the left forearm → −30° about Y... .
-    expected = Rotation.from_matrix(
-        SMPL_TO_CANONICAL
-        @ Rotation.from_euler("z", 30, degrees=True).as_matrix()
-        @ SMPL_TO_CANONICAL.T
-    ).as_rotvec()
-    assert np.allclose(motion.rotations[1, JOINT_INDEX["L_elbow"]], expected, atol=1e-9)
-    assert np.allclose(motion.rotations[2, JOINT_INDEX["head"]], np.radians([20, 0, 0]), atol=1e-9)
-    # Root translation: relative to frame 0, scaled to metres (leg 14 units → 0.79 m), Y up → Z up.
-    assert np.allclose(motion.translation[2], [10 * 0.79 / 14, 0, 0])
+@pytest.mark.parametrize("width", [None, 72, 156])
+def test_ncs_style_npz(tmp_path, width):
+    frames = 4
+    poses = _ncs_poses(frames)
+    trans = np.zeros((frames, 3))
+    trans[:, 1] = [0.9, 1.0, 1.1, 1.2]  # rising along SMPL's Y (up)
+    trans[:, 2] = [0.0, 0.1, 0.2, 0.3]  # walking along SMPL's Z (front)
+    path = tmp_path / "ncs_clip.npz"
+    stored = poses if width is None else np.zeros((frames, width))
+    if width is not None:
+        stored[:, :72] = poses.reshape(frames, 72)
+        stored[:, 66:] = 0.3  # SMPL's hands (72) or SMPL-H fingers (156): not the hands
+    np.savez(path, poses=stored, trans=trans, fps=30.0)
+    for motion in (load_npz_motion(path), load_motion(path)):
+        assert motion.fps == 30 and motion.num_frames == frames
+        assert np.allclose(motion.rotations[0, 0], 0, atol=1e-12)  # upright without a turn
+        assert np.allclose(motion.rotations[1, 0], [0, 0, 0.3])  # SMPL Y is our Z
+        assert np.allclose(motion.rotations[:, JOINT_INDEX["L_shoulder"]], [0, 0.8, 0])
+        # Y up → Z up, front +Z → −Y.
+        assert np.allclose(motion.translation[-1], [0, -0.3, 0.3])
+        assert np.allclose(motion.rotations[:, JOINT_INDEX["L_hand"]], 0) == (width != 72)
+    # up_axis="z" reads the same file as an AMASS-like Z-up world: the root turns.
+    z_up = load_npz_motion(path, up_axis="z")
+    assert np.allclose(z_up.translation[-1], [0, 0.3, 0.3])
+    assert not np.allclose(z_up.rotations[0, 0], 0)
+    assert np.allclose(load_motion(path, up_axis="z").translation, z_up.translation)
 
 
-def test_bvh_missing_joint_is_an_error(tmp_path):
-    path = tmp_path / "broken.bvh"
-    joints = [j for j in _CMU if j[0] not in ("LeftLeg",)]
-    joints = [(n, "LeftUpLeg" if p == "LeftLeg" else p, o) for n, p, o in joints]
-    _write_bvh(path, joints, frames=np.zeros((2, 3 + 3 * len(joints))))
-    with pytest.raises(MotionError, match="broken.bvh.*L_knee"):
-        load_bvh_motion(path)
-    (tmp_path / "garbage.bvh").write_text("HIERARCHY\nnonsense {")
-    with pytest.raises(MotionError, match="garbage.bvh"), warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        load_bvh_motion(tmp_path / "garbage.bvh")
+def test_amass_up_axis_is_z_unless_told(tmp_path):
+    poses = np.zeros((2, 72))
+    trans = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    path = tmp_path / "amass.npz"
+    np.savez(path, poses=poses, trans=trans, mocap_framerate=np.array(60.0))
+    assert np.allclose(load_npz_motion(path).translation[-1], [0, 1, 0])
+    assert np.allclose(load_npz_motion(path, up_axis="y").translation[-1], [0, 0, 1])
+
+
+def _assert_rig_message(message, path_name, joints):
+    assert message.startswith(str(path_name)) and "\n" not in message
+    assert f"quaternions on a {joints}-joint rig" in message and "not SMPL" in message
+    assert "export it as BVH" in message and "--joint-map" in message
+    assert "has no 'mocap_framerate'" not in message
+
+
+def test_a_quaternion_rig_npz_is_named_not_blamed_on_its_frame_rate(tmp_path):
+    path = tmp_path / "mixamo_like.npz"
+    np.savez(path, poses=np.tile([1.0, 0, 0, 0], (5, 65, 1)), trans=np.zeros((5, 3)),
+             fps=np.array(30.0), source=np.array("Run Forward (1).fbx"))  # fmt: skip
+    with pytest.raises(MotionError) as info:
+        load_motion(path)
+    _assert_rig_message(str(info.value), path, 65)
+    assert "'Run Forward (1).fbx'" in str(info.value)
+
+
+@pytest.mark.skipif(
+    not MIXAMO_NPZ.is_file(),
+    reason=f"{MIXAMO_NPZ} is absent: third-party test data kept in ../shared/real-world "
+    "beside the repository, not in a clone",
+)
+def test_the_real_mixamo_npz_gets_an_accurate_message():
+    with pytest.raises(MotionError) as info:
+        load_motion(MIXAMO_NPZ)
+    _assert_rig_message(str(info.value), MIXAMO_NPZ, 65)
+
+
+@pytest.mark.parametrize(
+    ("arrays", "match"),
+    [
+        ({"trans": np.zeros((4, 3)), "fps": 30.0}, "no 'poses' array.*supported .npz motions"),
+        ({"poses": np.zeros((4, 24, 3)), "trans": np.zeros((4, 3))}, "no frame rate"),
+        ({"poses": np.zeros((4, 24, 3)), "fps": 30.0}, "no 'trans'"),
+        ({"poses": np.zeros((4, 70)), "trans": np.zeros((4, 3)), "fps": 30.0}, r"\(T, 24, 3\)"),
+        ({"poses": np.zeros((4, 52, 3)), "trans": np.zeros((4, 3)), "fps": 30.0},
+         "3-vectors on a 52-joint rig"),
+        ({"poses": np.zeros((4, 24, 3)), "trans": np.zeros((4, 3)), "fps": 0.0}, "'fps' must be"),
+        ({"poses": np.zeros((4, 24, 3)), "trans": np.zeros((3, 3)), "fps": 30.0}, "translation"),
+    ],
+)  # fmt: skip
+def test_npz_errors_name_the_file(tmp_path, arrays, match):
+    path = tmp_path / "bad_motion.npz"
+    np.savez(path, **arrays)
+    with pytest.raises(MotionError, match=match) as info:
+        load_motion(path)
+    assert "bad_motion.npz" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_options_a_motion_cannot_use_are_refused(tmp_path):
+    path = tmp_path / "clip.npz"
+    np.savez(path, poses=np.zeros((2, 72)), trans=np.zeros((2, 3)), mocap_framerate=30.0)
+    with pytest.raises(MotionError, match="joint map applies to .bvh motions only"):
+        load_motion(path, joint_map={"L_hip": "Thigh"})
+    with pytest.raises(MotionError, match="up axis applies to .npz and .bvh"):
+        load_motion("walk", up_axis="y", duration=1.0)
+    with pytest.raises(MotionError, match="up_axis must be"):
+        load_motion(path, up_axis="x")
