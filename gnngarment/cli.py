@@ -342,8 +342,10 @@ def _collision_settings():
         raise fail(str(error)) from None
 
 
-def _load_body_and_motion(body_shape: str, motion: str, fps: float, duration: float):
-    """Anny body, its shape and a motion (procedural name or file), or a clear failure."""
+def _load_body_and_motion(body_shape: str, motion: str, fps: float, duration: float,
+                          joint_map: Path | None = None, motion_up_axis: str = "auto"):
+    """Anny body, its shape and a motion (procedural name or file, retargeted onto this
+    shape's rest skeleton), or a clear failure."""
     from gnngarment.body import AnnyBodyModel, MotionError, load_motion
 
     body_model = AnnyBodyModel()
@@ -352,8 +354,11 @@ def _load_body_and_motion(body_shape: str, motion: str, fps: float, duration: fl
     except (ValueError, OSError) as error:
         raise fail(f"--body-shape {body_shape}: {error}") from None
     try:
-        motion_value = load_motion(motion, fps=fps, **(
-            {"duration": duration} if not Path(motion).suffix else {}))
+        is_file = bool(Path(motion).suffix)
+        motion_value = load_motion(
+            motion, fps=fps, joint_map=joint_map, up_axis=motion_up_axis,
+            **({"rest_joints": body_model.rest(shape).joints.numpy()} if is_file
+               else {"duration": duration}))
     except (MotionError, ValueError, OSError) as error:
         raise fail(f"--motion {motion}: {error}") from None
     return body_model, shape, motion_value
@@ -413,6 +418,11 @@ def animate(
         help="Procedural motion name (gnngarment motions) or .npz/.bvh/info.mat.")] = "walk",
     duration: Annotated[float, typer.Option(help="Seconds of a procedural motion.")] = 2.0,
     fps: Annotated[float, typer.Option(help="Frames per second.")] = 30.0,
+    joint_map: Annotated[Path | None, typer.Option(
+        help="BVH only: JSON/YAML file mapping canonical joint names (pelvis, L_hip, ...) to "
+             "the BVH's joint names (docs/motions.md).")] = None,
+    motion_up_axis: Annotated[str, typer.Option(
+        help="Up axis of a .npz/.bvh motion: auto, y or z.")] = "auto",
     formats: Annotated[str, typer.Option("--format", help="Comma list: obj,pc2,glb,gif.")
                        ] = "obj,pc2,glb,gif",
     body: Annotated[bool, typer.Option(help="Also export the posed body.")] = True,
@@ -452,7 +462,6 @@ def animate(
 
     if not (fps > 0 and fps != float("inf")):  # also NaN; checked before any loading
         raise fail(f"--fps must be a finite number > 0, got {fps}")
-    _check_output_folder(out)
     checkpoint = checkpoint or SHIPPED_MODEL
     try:
         model = load_model(checkpoint)
@@ -460,7 +469,10 @@ def animate(
         source = None if source_body is None else load_mesh(source_body)
     except (MeshError, ValueError) as error:
         raise fail(str(error)) from None
-    body_model, shape, motion_value = _load_body_and_motion(body_shape, motion, fps, duration)
+    body_model, shape, motion_value = _load_body_and_motion(body_shape, motion, fps, duration,
+                                                            joint_map, motion_up_axis)
+    # Inputs are read and valid; the output folder is checked before the long work.
+    _check_output_folder(out)
     body_inputs = body_shape_inputs(body_model, shape, model.config.body_vertices)
     try:
         placed = place_garment(pos, faces, body_inputs, units=fix_units, up_axis=up_axis,

@@ -161,6 +161,11 @@ def attribute_command(
     fps: Annotated[float, typer.Option("--fps", help="Motion frame rate.")] = 30.0,
     duration: Annotated[float, typer.Option(
         "--duration", help="Seconds (procedural motions).")] = 4.0,
+    joint_map: Annotated[Path | None, typer.Option(
+        "--joint-map", help="BVH only: JSON/YAML file mapping canonical joint names to the "
+        "BVH's (docs/motions.md).")] = None,
+    motion_up_axis: Annotated[str, typer.Option(
+        "--motion-up-axis", help="Up axis of a .npz/.bvh motion: auto, y or z.")] = "auto",
 ) -> None:
     """Integrated-gradient heatmap (paper Eq. 9) of a predicted deformation: PNG, PLY,
     NPZ and JSON in --out."""
@@ -196,8 +201,11 @@ def attribute_command(
             body_shape = body.parse_shape(shape)
             count = model.config.body_vertices
             shape_inputs = body_shape_inputs(body, body_shape, count)
+            is_file = bool(Path(motion).suffix)
             frames = body_motion_inputs(body, body_shape, load_motion(
-                motion, fps=fps, duration=duration), count)
+                motion, fps=fps, joint_map=joint_map, up_axis=motion_up_axis,
+                **({"rest_joints": body.rest(body_shape).joints.numpy()} if is_file
+                   else {"duration": duration})), count)
     except (MotionError, SMPLModelError, ValueError) as error:
         _fail(str(error))
     try:

@@ -76,6 +76,13 @@ def body_command(
     seed: Annotated[
         int | None, typer.Option("--seed", help="Seeded variation of procedural motions.")
     ] = None,
+    joint_map: Annotated[
+        Path | None, typer.Option("--joint-map", help="BVH only: JSON/YAML file mapping "
+                                  "canonical joint names to the BVH's (docs/motions.md).")
+    ] = None,
+    motion_up_axis: Annotated[
+        str, typer.Option("--motion-up-axis", help="Up axis of a .npz/.bvh motion: auto, y, z.")
+    ] = "auto",
     rest: Annotated[
         bool, typer.Option("--rest", help="Write only the rest body (rest_body.obj, metres, Z "
                            "up, facing -Y: the frame `animate` expects a garment in) and its "
@@ -103,8 +110,9 @@ def body_command(
     if model not in ("anny", "smpl"):
         _fail(f"--model must be 'anny' or 'smpl', got '{model}'")
     try:
-        motion_data = None if rest else load_motion(motion, fps=fps, duration=duration,
-                                                    seed=seed)
+        motion_data = None if rest else load_motion(
+            motion, fps=fps, joint_map=joint_map, up_axis=motion_up_axis,
+            **({} if Path(motion).suffix else {"duration": duration, "seed": seed}))
     except MotionError as error:
         _fail(str(error))
     try:

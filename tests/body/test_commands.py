@@ -37,6 +37,9 @@ def test_bad_input_exits_2_without_traceback(tmp_path):
         ["body", "--motion", "moonwalk", "--out", str(tmp_path)],
         ["body", "--motion", str(tmp_path / "x.fbx"), "--out", str(tmp_path)],
         ["body", "--fps", "0", "--out", str(tmp_path)],
+        ["body", "--motion", "walk", "--joint-map", str(tmp_path / "map.json"), "--out",
+         str(tmp_path)],
+        ["body", "--motion", "walk", "--motion-up-axis", "w", "--out", str(tmp_path)],
         [
             "body",
             "--model",
