@@ -156,8 +156,10 @@ def resolved_sequence_metrics(pred: np.ndarray, dataset: PreparedDataset, name: 
                               settings: CollisionSettings | None = None) -> dict[str, float]:
     """:func:`sequence_metrics` of ``pred (T, N, 3)`` after collision resolution against
     the posed body mesh ``(vertices (T, N_b, 3), faces (F_b, 3))``, plus ``raw_e_verts_mm``
-    and ``raw_collision_pct`` of ``pred`` itself (measured the same way). Without a body
-    mesh nothing is resolved and the metrics equal the raw ones."""
+    and ``raw_collision_pct`` of ``pred`` itself (measured the same way). With the mesh,
+    both collision figures are against it (:func:`metrics.mesh_collision_rate`); without
+    one nothing is resolved, the metrics equal the raw ones and collisions are measured
+    against the cache's body samples."""
     raw = sequence_metrics(pred, dataset, name)
     values = raw
     if body_mesh is not None:
@@ -168,6 +170,12 @@ def resolved_sequence_metrics(pred: np.ndarray, dataset: PreparedDataset, name: 
         resolved, _ = resolve_collisions(pred, dataset.garment_of(name).faces.numpy(),
                                          vertices, body_faces, settings)
         values = sequence_metrics(resolved, dataset, name)
+        # With the body mesh at hand, inside means inside the mesh (exact), for the
+        # network's output and for what users get alike.
+        raw = {**raw, "collision_pct": float(metrics.mesh_collision_rate(
+            pred, vertices, body_faces).mean())}
+        values = {**values, "collision_pct": float(metrics.mesh_collision_rate(
+            resolved, vertices, body_faces).mean())}
     return {**values, "raw_e_verts_mm": raw["e_verts_mm"],
             "raw_collision_pct": raw["collision_pct"]}
 
