@@ -301,6 +301,8 @@ def evaluate(
     from gnngarment.evaluation import write_report
     from gnngarment.training.checkpoint import load_checkpoint, load_model
 
+    for option, path in (("--json", json_path), ("--markdown", markdown)):
+        _check_output_file(option, path)
     try:
         model = load_model(checkpoint)
         if data is None:
@@ -324,6 +326,16 @@ def evaluate(
     bar.close()
     console.print(report.to_markdown())
     write_report(report, markdown, json_path)
+
+
+def _check_output_file(option: str, path: Path | None) -> None:
+    """Before any work: ``path`` (if given) is not a folder and its folder exists."""
+    if path is None:
+        return
+    if path.is_dir():
+        raise fail(f"{option} {path}: is a folder; give a file name")
+    if not path.parent.is_dir():
+        raise fail(f"{option} {path}: the folder {path.parent} does not exist")
 
 
 def _collision_settings():

@@ -169,3 +169,35 @@ def test_prepare_from_cloth3d_with_a_bad_smpl_model_is_one_line_exit_2(
     lines = [line for line in result.output.splitlines() if line.strip()]
     assert len(lines) == 1 and str(model) in " ".join(result.output.split())
     assert "Traceback" not in result.output and not (tmp_path / "out").exists()
+
+
+def test_evaluate_refuses_a_mismatched_checkpoint_and_unusable_outputs_up_front(
+        tmp_path: Path) -> None:
+    """One line, exit 2, before any evaluation: a checkpoint whose weights do not fit its
+    model config (a key missing), a --json that is a folder, a --markdown whose folder
+    does not exist."""
+    import torch
+
+    from gnngarment.model import GarmentDeformer
+    from gnngarment.training.checkpoint import model_payload, save_checkpoint
+    from tests.model.pairs import tiny_config
+
+    torch.manual_seed(0)
+    payload = model_payload(GarmentDeformer(tiny_config()))
+    good = tmp_path / "good.pt"
+    save_checkpoint(good, payload)
+    state = dict(payload["model_state"])
+    state.pop(next(iter(state)))
+    broken = tmp_path / "broken.pt"
+    save_checkpoint(broken, {**payload, "model_state": state})
+    cases = [
+        (["--checkpoint", str(broken)], "the weights do not fit the model"),
+        (["--checkpoint", str(good), "--json", str(tmp_path)], "is a folder"),
+        (["--checkpoint", str(good), "--markdown", str(tmp_path / "no" / "t.md")],
+         "does not exist"),
+    ]
+    for arguments, message in cases:
+        result = runner.invoke(app, ["evaluate", "--data", str(tmp_path / "none"), *arguments])
+        assert result.exit_code == 2, (arguments, result.output)
+        text = " ".join(result.output.split())
+        assert message in text and "Traceback" not in text, text

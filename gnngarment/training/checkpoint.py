@@ -144,11 +144,22 @@ def stored_model_config(stored: dict[str, Any], source: str = "<checkpoint>") ->
 
 
 def load_model(path: str | Path) -> GarmentDeformer:
-    """Rebuild a model from a checkpoint, in eval mode."""
+    """Rebuild a model from a checkpoint, in eval mode.
+
+    Raises:
+        ValueError: unreadable, or its weights do not fit its model config (names it).
+    """
     payload = load_checkpoint(path)
     config = stored_model_config(payload["model_config"], source=str(path))
     model = GarmentDeformer(config)
-    model.load_state_dict(payload["model_state"])
+    try:
+        model.load_state_dict(payload["model_state"])
+    except (RuntimeError, KeyError, TypeError) as error:
+        # torch lists every mismatched key over many lines: one line names the first.
+        first = str(error).replace("\n", " ").split(". ")[0]
+        raise ValueError(f"{path}: the weights do not fit the model its config describes "
+                         f"(another architecture or a damaged checkpoint): {first[:200]}"
+                         ) from None
     model.use_physics = bool(payload.get("use_physics", False))
     model.eval()
     return model
