@@ -34,6 +34,9 @@ class LossWeights:
     gravity: float = 0.1
     stretch: float = 5.0
     shear: float = 2.0
+    #: Not in the blueprint (0 = off): mean squared blend shape (m²), pulling the
+    #: corrections towards plain skinning of the template unless the data asks for them.
+    blend_shape: float = 0.0
 
 
 @dataclass

@@ -21,6 +21,11 @@ def vertex_loss(pred: torch.Tensor, target: torch.Tensor) -> torch.Tensor:
     return ((pred - target) ** 2).sum(-1).mean()
 
 
+def blend_shape_loss(blend_shapes: torch.Tensor) -> torch.Tensor:
+    """Mean squared blend shape (m²): zero for plain skinning of the template."""
+    return (blend_shapes ** 2).sum(-1).mean()
+
+
 def edge_lengths(pos: torch.Tensor, edges: torch.Tensor) -> torch.Tensor:
     """``(E,)`` lengths of the edges ``(2, E)``."""
     return (pos[edges[0]] - pos[edges[1]]).norm(dim=-1)

@@ -12,11 +12,13 @@ from gnngarment.training.config import LossWeights, StageConfig
 
 def stage_weights(stage: str, weights: LossWeights, stages: StageConfig) -> dict[str, float]:
     """The weight of every term in ``stage`` (0 = off)."""
+    extra = {"blend_shape": weights.blend_shape} if weights.blend_shape > 0 else {}
     if stage == "supervised":
-        return {"vertex": weights.vertex, "edge": weights.edge, "normal": weights.normal}
+        return {"vertex": weights.vertex, "edge": weights.edge, "normal": weights.normal,
+                **extra}
     scaled = {"vertex": weights.vertex * stages.physics_scale,
               "edge": weights.edge * stages.physics_scale,
-              "collision": weights.collision, "gravity": weights.gravity}
+              "collision": weights.collision, "gravity": weights.gravity, **extra}
     if stage == "physics_strain":
         scaled |= {"stretch": weights.stretch, "shear": weights.shear}
     return scaled
@@ -42,6 +44,8 @@ def loss_terms(output: DeformerOutput, batch: TrainingBatch, names: list[str],
             # weight) is the same as for absolute heights, the value stays readable.
             terms[name] = losses.gravity_loss(pred, batch.target, batch.vertex_mass,
                                               int(batch.item.max()) + 1)
+        elif name == "blend_shape":
+            terms[name] = losses.blend_shape_loss(output.blend_shapes)
         elif name == "stretch":
             terms[name] = losses.stretch_loss(pred, batch.faces, batch.rest_inverse,
                                               batch.rest_area)

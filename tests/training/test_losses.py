@@ -10,6 +10,7 @@ import torch
 from gnngarment.geometry.triangle_frames import rest_triangle_frames as numpy_frames
 from gnngarment.geometry.triangle_frames import vertex_masses
 from gnngarment.training.losses import (
+    blend_shape_loss,
     collision_loss,
     edge_loss,
     gravity_loss,
@@ -122,3 +123,17 @@ def test_gravity_is_weight_times_height_and_pulls_down(sheet) -> None:
     assert math.isclose(loss.item(), 9.81 * 0.024 * 0.1 / 2, rel_tol=1e-6)
     loss.backward()
     assert (lifted.grad[:, 2] > 0).all() and (lifted.grad[:, :2] == 0).all()
+
+
+def test_blend_shape_penalty_is_zero_for_plain_skinning_and_only_when_asked() -> None:
+    from gnngarment.training.config import LossWeights, StageConfig
+    from gnngarment.training.objective import stage_weights
+
+    blend = torch.zeros(5, 3)
+    assert float(blend_shape_loss(blend)) == 0.0
+    blend[0] = torch.tensor([0.03, 0.0, 0.04])                 # one vertex 5 cm off
+    assert float(blend_shape_loss(blend)) == pytest.approx(0.05 ** 2 / 5)
+    for stage in ("supervised", "physics", "physics_strain"):
+        assert "blend_shape" not in stage_weights(stage, LossWeights(), StageConfig())
+        assert stage_weights(stage, LossWeights(blend_shape=100.0),
+                             StageConfig())["blend_shape"] == 100.0
