@@ -427,6 +427,7 @@ def _read_bvh(path: Path) -> tuple[list[str], list[int], np.ndarray, np.ndarray,
     try:
         frames = np.asarray(mocap.frames, dtype=np.float64)
         frame_time = float(mocap.frame_time)
+        declared = int(mocap.nframes)
         index = {name: i for i, name in enumerate(names)}
         parents, offsets, channels = [], [], []
         for name in names:
@@ -439,6 +440,9 @@ def _read_bvh(path: Path) -> tuple[list[str], list[int], np.ndarray, np.ndarray,
         raise unreadable(error) from error
     if not names or frames.ndim != 2 or frames.shape[0] < 1:
         raise MotionError(f"{path}: BVH file has no joints or no frames")
+    if frames.shape[0] != declared:
+        raise MotionError(f"{path}: BVH declares {declared} frames ('Frames:') but holds "
+                          f"{frames.shape[0]}: the file is cut short or damaged")
     if not np.isfinite(frame_time) or frame_time <= 0:
         raise MotionError(f"{path}: BVH frame time must be > 0, got {frame_time}")
     if not np.all(np.isfinite(frames)):

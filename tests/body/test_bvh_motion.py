@@ -809,6 +809,12 @@ def test_missing_joint_and_unreadable_files(tmp_path):
     path.write_text(path.read_text().replace("JOINT RightFingerBase", "JOINT RightHand"))
     with pytest.raises(MotionError, match="twice.bvh: BVH joint names must be unique: RightHand"):
         _quiet_load(path)
+    # Cut short: the motion section declares more frames than it holds.
+    path = _write_bvh(tmp_path / "cut.bvh", CGSPEED, np.zeros((3, 3 + 3 * len(CGSPEED))))
+    lines = path.read_text().splitlines()
+    path.write_text("\n".join(lines[:-1]) + "\n")
+    with pytest.raises(MotionError, match="cut.bvh: BVH declares 3 frames.*holds 2"):
+        _quiet_load(path)
 
 
 def test_load_motion_passes_the_joint_map(tmp_path):
