@@ -16,7 +16,7 @@ Targets (issue 13): inside < 1 % after resolution; walking median distance withi
 of the source-body distance.
 
     .venv/bin/python benchmarks/real_garments.py [--checkpoint PATH] [--motion walk]
-        [--shared ../shared]
+        [--shared ../shared] [--images docs/images/real_garments]
 """
 
 from __future__ import annotations
@@ -63,6 +63,35 @@ def distances(pos: np.ndarray, vertices: np.ndarray, faces: np.ndarray) -> np.nd
         np.asarray(pos, dtype=np.float64))
 
 
+def write_strip(animation, path: Path, frames: int = 4, size: int = 240) -> Path:
+    """A PNG of ``frames`` evenly spaced frames side by side (garment red, body grey),
+    from the library's own preview renderer."""
+    import tempfile
+    from dataclasses import replace
+
+    from PIL import Image
+
+    from gnngarment.inference.export import render_preview
+
+    chosen = np.linspace(0, len(animation.posed) - 1, frames).round().astype(int)
+    picked = replace(animation, posed=animation.posed[chosen],
+                     body_vertices=animation.body_vertices[chosen])
+    with tempfile.TemporaryDirectory() as folder:
+        gif = render_preview(picked, Path(folder) / "strip.gif", size=size,
+                             max_frames=frames, supersample=2)
+        image = Image.open(gif)
+        tiles = []
+        for index in range(frames):
+            image.seek(index)
+            tiles.append(image.convert("RGB").copy())
+    strip = Image.new("RGB", (size * frames, size), "white")
+    for index, tile in enumerate(tiles):
+        strip.paste(tile, (index * size, 0))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    strip.save(path, optimize=True)
+    return path
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--checkpoint", type=Path, default=SHIPPED_MODEL)
@@ -70,6 +99,8 @@ def main() -> None:
     parser.add_argument("--shared", type=Path, default=ROOT.parent / "shared")
     parser.add_argument("--frames-measured", type=int, default=10,
                         help="Frames (evenly spaced) measured per garment.")
+    parser.add_argument("--images", type=Path, default=None,
+                        help="Also write <garment>.png here: 4 frames of the walk.")
     args = parser.parse_args()
     torch.set_num_threads(1)
     real = args.shared / "real-world"
@@ -103,6 +134,8 @@ def main() -> None:
             walking.append(np.median(np.abs(resolved)))
             inside.append(np.mean(resolved < -INSIDE_DEPTH))
             raw_inside.append(np.mean(raw < -INSIDE_DEPTH))
+        if args.images is not None:
+            write_strip(result, args.images / f"{garment}.png")
         print(f"| {garment} | {len(pos)} | {placed.seconds['fit']:.1f} | "
               f"{1000 * placed.fitted.registration_error:.1f} | {1000 * source_distance:.1f} | "
               f"{1000 * rest_distance:.1f} | {1000 * np.mean(walking):.1f} | "

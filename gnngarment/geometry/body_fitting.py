@@ -32,7 +32,8 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from gnngarment.geometry.graph import adjacency_matrix, edge_index_from_faces
-from gnngarment.geometry.normals import face_normals, vertex_normals
+from gnngarment.geometry.normals import vertex_normals
+from gnngarment.geometry.surface_sampling import surface_samples
 
 #: Surface samples per body for the alignment's distances (area-uniform, fixed seed).
 ALIGNMENT_SAMPLES = 4000
@@ -106,25 +107,6 @@ def axis_turns() -> list[np.ndarray]:
     return turns
 
 
-def surface_samples(vertices: np.ndarray, faces: np.ndarray, count: int,
-                    seed: int = 0) -> np.ndarray:
-    """``(count, 3)`` points uniform over the surface area (fixed ``seed``: one body
-    always gives one answer)."""
-    vertices = np.asarray(vertices, dtype=np.float64)
-    faces = np.asarray(faces, dtype=np.int64)
-    area = 0.5 * np.linalg.norm(face_normals(vertices, faces, normalize=False), axis=1)
-    if not area.sum() > 0:
-        raise ValueError("the mesh has no area")
-    rng = np.random.default_rng(seed)
-    chosen = rng.choice(len(faces), size=count, p=area / area.sum())
-    u, v = rng.random((2, count))
-    flip = u + v > 1
-    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
-    corners = vertices[faces[chosen]]
-    return (corners[:, 0] + u[:, None] * (corners[:, 1] - corners[:, 0])
-            + v[:, None] * (corners[:, 2] - corners[:, 0]))
-
-
 def _chamfer(points: np.ndarray, tree: cKDTree, target: np.ndarray) -> float:
     forward = tree.query(points)[0]
     backward = cKDTree(points).query(target)[0]
@@ -154,8 +136,8 @@ def align_bodies(source_vertices: np.ndarray, source_faces: np.ndarray,
     Raises:
         ValueError: a mesh without area, or a scale outside :data:`SCALE_RANGE`.
     """
-    source = surface_samples(source_vertices, source_faces, ALIGNMENT_SAMPLES)
-    target = surface_samples(target_vertices, target_faces, ALIGNMENT_SAMPLES, seed=1)
+    source, _ = surface_samples(source_vertices, source_faces, ALIGNMENT_SAMPLES)
+    target, _ = surface_samples(target_vertices, target_faces, ALIGNMENT_SAMPLES, seed=1)
     tree = cKDTree(target)
     scored = []
     for turn in axis_turns():
@@ -284,7 +266,7 @@ def fit_garment(garment: np.ndarray, garment_faces: np.ndarray,
     aligned_body = alignment.apply(source_vertices)
     registered = register_bodies(aligned_body, source_faces, target_vertices, target_faces)
     pos = carry_garment(alignment.apply(garment), garment_faces, aligned_body, registered)
-    error = float(cKDTree(surface_samples(target_vertices, target_faces, 20000))
-                  .query(registered)[0].mean())
+    samples, _ = surface_samples(target_vertices, target_faces, 20000)
+    error = float(cKDTree(samples).query(registered)[0].mean())
     return FittedGarment(pos=pos, alignment=alignment, source_body=registered,
                          registration_error=error)

@@ -316,21 +316,14 @@ class _Surface:
         from scipy.spatial import cKDTree
 
         from gnngarment.geometry.normals import face_normals, vertex_normals
+        from gnngarment.geometry.surface_sampling import surface_samples
 
         if faces is None:
             self.points, self.normals = vertices, None
         else:
             faces = np.asarray(faces, dtype=np.int64)
             flip = -1.0 if _signed_volume(vertices, faces) < 0 else 1.0
-            area = 0.5 * np.linalg.norm(face_normals(vertices, faces, normalize=False), axis=1)
-            rng = np.random.default_rng(0)  # fixed: the same body always gives one answer
-            chosen = rng.choice(len(faces), size=samples, p=area / area.sum())
-            u, v = rng.random((2, samples))
-            outside = u + v > 1
-            u[outside], v[outside] = 1 - u[outside], 1 - v[outside]
-            corners = vertices[faces[chosen]]
-            sampled = (corners[:, 0] + u[:, None] * (corners[:, 1] - corners[:, 0])
-                       + v[:, None] * (corners[:, 2] - corners[:, 0]))
+            sampled, chosen = surface_samples(vertices, faces, samples)
             self.points = np.concatenate([vertices, sampled])
             self.normals = flip * np.concatenate([vertex_normals(vertices, faces),
                                                   face_normals(vertices, faces[chosen])])
