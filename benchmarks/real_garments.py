@@ -10,7 +10,9 @@ animate it on a walk with the shipped (or a given) model, and print
   and on the walking body (mean over frames of the per-frame median), in mm;
 * the share of garment vertices inside the walking body after collision resolution
   and in the network's raw output (%, mean over frames; inside = more than 2 mm deep,
-  the nearest-point sign of a dense body sampling).
+  the nearest-point sign of a dense body sampling);
+* the largest share of any vertex's skinning weight on joints whose body region is more
+  than 20 cm from it (far weight, :func:`~gnngarment.evaluation.metrics.far_joint_weight`).
 
 Targets (issue 13): inside < 1 % after resolution; walking median distance within 1 cm
 of the source-body distance.
@@ -35,6 +37,7 @@ if str(ROOT) not in sys.path:
 
 from gnngarment.body import AnnyBodyModel, load_motion  # noqa: E402
 from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs  # noqa: E402
+from gnngarment.evaluation.metrics import far_joint_weight  # noqa: E402
 from gnngarment.geometry.mesh_io import load_mesh  # noqa: E402
 from gnngarment.inference.animate import animate  # noqa: E402
 from gnngarment.inference.checks import _Surface  # noqa: E402
@@ -75,7 +78,11 @@ def write_strip(animation, path: Path, frames: int = 4, size: int = 240) -> Path
 
     chosen = np.linspace(0, len(animation.posed) - 1, frames).round().astype(int)
     picked = replace(animation, posed=animation.posed[chosen],
-                     body_vertices=animation.body_vertices[chosen])
+                     body_vertices=animation.body_vertices[chosen],
+                     weights=animation.weights[chosen],
+                     blend_shapes=animation.blend_shapes[chosen],
+                     joint_transforms=animation.joint_transforms[chosen],
+                     raw_posed=None)
     with tempfile.TemporaryDirectory() as folder:
         gif = render_preview(picked, Path(folder) / "strip.gif", size=size,
                              max_frames=frames, supersample=2)
@@ -114,8 +121,8 @@ def main() -> None:
                                 model.config.body_vertices)
     print(f"checkpoint {args.checkpoint}, motion {args.motion} ({len(frames.vertices)} frames)")
     print("| garment | vertices | fit s | registration mm | median distance mm: source | "
-          "rest | walking | inside % resolved | inside % raw | animate s |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+          "rest | walking | inside % resolved | inside % raw | far weight % max | animate s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for garment, source_name in SOURCE_BODIES.items():
         pos, faces = load_mesh(real / "garments" / f"{garment}.obj")
         source = load_mesh(real / "bodies" / f"{source_name}.obj")
@@ -134,13 +141,15 @@ def main() -> None:
             walking.append(np.median(np.abs(resolved)))
             inside.append(np.mean(resolved < -INSIDE_DEPTH))
             raw_inside.append(np.mean(raw < -INSIDE_DEPTH))
+        far = far_joint_weight(result.weights, result.rest_pos, body.rest_vertices,
+                               body.skinning_weights)["max"]
         if args.images is not None:
             write_strip(result, args.images / f"{garment}.png")
         print(f"| {garment} | {len(pos)} | {placed.seconds['fit']:.1f} | "
               f"{1000 * placed.fitted.registration_error:.1f} | {1000 * source_distance:.1f} | "
               f"{1000 * rest_distance:.1f} | {1000 * np.mean(walking):.1f} | "
               f"{100 * np.mean(inside):.2f} | {100 * np.mean(raw_inside):.2f} | "
-              f"{seconds:.1f} |", flush=True)
+              f"{100 * far:.1f} | {seconds:.1f} |", flush=True)
 
 
 if __name__ == "__main__":
