@@ -2,6 +2,7 @@
 # torch==2.13.0 is installed FIRST, on its own: pip finds the CPU wheel on disk
 # (pip's find-links). Anything that depends on torch installed before it would pull
 # the newest torch from the registry together with several GB of CUDA packages.
+# The ray extra is installed too: the tests build a dataset on a local Ray instance.
 
 PYTHON ?= python3
 VENV   ?= .venv
@@ -18,7 +19,7 @@ $(PY):
 $(STAMP): pyproject.toml | $(PY)
 	$(PIP) install --quiet --upgrade pip
 	$(PIP) install --quiet "torch==2.13.0"
-	$(PIP) install --quiet -e ".[dev]"
+	$(PIP) install --quiet -e ".[dev,ray]"
 	touch $(STAMP)
 
 install: $(STAMP)

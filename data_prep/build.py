@@ -7,15 +7,16 @@ use one core each), checked by the simulator's quality gates, written in the CLO
 format under ``raw/`` and as a prepared-cache file under ``sequences/``. A sequence
 whose cache file exists with the same input hash is skipped, so an interrupted build
 (even kill -9) resumes where it stopped; files appear only complete (temp + rename);
-``manifest.json`` is written last.
+``manifest.json`` is written last. The workers run in a local process pool or, with
+``executor: ray``, as Ray tasks on a cluster (:mod:`data_prep.executor`); the output is
+the same either way.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-import multiprocessing
-import os
+import math
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -484,24 +485,39 @@ def build_dataset(config: DataConfig, workers: int | None = None,
 
     Raises:
         FolderBusyError: another build holds ``config.output``.
+        RayMissingError: ``config.executor`` is ``ray`` and Ray is not installed.
     """
+    if config.executor == "ray":  # before any work, not after the bodies
+        from data_prep.ray_executor import import_ray
+
+        import_ray()
     root = Path(config.output)
     with FolderLock(root, "`gnngarment prepare`") as lock:
         # A killed build can leave the temporary file of a write it did not finish: with
         # the lock held no other build is writing here, so those (and only those names)
         # are stale.
         lock.remove_stale_temporaries(CACHE_FOLDERS)
-        return _build_locked(root, config, workers, log)
+        return _build_locked(root, config, workers, log, lock)
 
 
 #: The folders a build writes (stale temporary files are looked for only there).
 CACHE_FOLDERS = ("raw", "garments", "sequences", "topologies", "bodies", ".")
 
 
+def _lost(task: tuple, error: Exception) -> dict[str, Any]:
+    """The status of a task whose worker process died more often than Ray retries it:
+    left out of this build, not recorded as failed (the next build tries it again)."""
+    plan = task[1]
+    name = plan.name if isinstance(plan, SequencePlan) else f"{plan.name}_{task[2].name}"
+    return {"name": name, "ok": False, "reason": f"worker lost: {type(error).__name__}",
+            "seconds": math.nan}
+
+
 def _build_locked(root: Path, config: DataConfig, workers: int | None,
-                  log: Callable[[str], None]) -> dict[str, Any]:
+                  log: Callable[[str], None], lock: FolderLock) -> dict[str, Any]:
     from tqdm import tqdm
 
+    from data_prep.executor import make_executor
     from data_prep.simulate import load_simulation_settings
     from gnngarment.data.cache import write_manifest
 
@@ -509,9 +525,10 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
     plans = plan_dataset(config)
     settings = load_simulation_settings(config.simulation)
     # What decides a sequence's content: not where the dataset lives, how many
-    # processes build it, or the path of the simulation file (its settings are hashed).
+    # processes build it or where, or the path of the simulation file (its settings are
+    # hashed).
     content = {k: v for k, v in asdict(config).items()
-               if k not in ("output", "workers", "simulation")}
+               if k not in ("output", "workers", "simulation", "executor", "ray_address")}
     base_hash = {"builder": BUILDER_VERSION, "config": content, "simulation": asdict(settings)}
 
     bodies = {p.body.name: p.body for p in plans}
@@ -532,18 +549,18 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
             continue
         drape_tasks.append((str(root), design, body, config, garment_hash))
 
-    workers = workers or config.workers or os.cpu_count() or 1
+    workers = workers or config.workers or None
     log(f"{len(garments)} garments planned: {len(garment_info)} already draped, "
         f"{len(failed_garments)} failed before with the same inputs, {len(drape_tasks)} to "
         "drape on their rest bodies")
-    context = multiprocessing.get_context("spawn")
-    pool = None
     results: list[dict[str, Any]] = []
-    try:
+    with make_executor(config.executor, workers, config.ray_address) as executor:
+        if executor.describe():
+            log(executor.describe())
         if drape_tasks:
             _warm_up_kernels(log)
-            pool = context.Pool(min(workers, len(drape_tasks)))
-            for result in tqdm(pool.imap_unordered(drape_and_prepare_garment, drape_tasks),
+            for result in tqdm(executor.imap_unordered(drape_and_prepare_garment, drape_tasks,
+                                                       lost=_lost),
                                total=len(drape_tasks), desc="draping", unit="garment"):
                 if result["ok"]:
                     garment_info[result["name"]] = result
@@ -567,21 +584,19 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
             tasks.append((str(root), plan, config, inputs_hash))
         log(f"{len(plans)} sequences planned: {skipped} already built, {len(known_failures)} "
             f"failed before with the same inputs, {len(tasks)} to simulate with "
-            f"{min(workers, max(len(tasks), 1))} worker(s)")
+            f"{executor.parallelism(len(tasks))} worker(s)")
         if tasks:
-            if pool is None:
+            if not drape_tasks:
                 _warm_up_kernels(log)
-                pool = context.Pool(min(workers, len(tasks)))
-            bar = tqdm(pool.imap_unordered(simulate_sequence, tasks), total=len(tasks),
-                       desc="simulating", unit="sequence")
+            bar = tqdm(executor.imap_unordered(simulate_sequence, tasks, lost=_lost),
+                       total=len(tasks), desc="simulating", unit="sequence")
             for result in bar:
                 results.append(result)
                 if not result["ok"]:
                     log(f"sequence {result['name']} left out: {result['reason']}")
-    finally:
-        if pool is not None:
-            pool.terminate()
-            pool.join()
+    # A worker killed mid-write (and retried) left a hidden temporary file; every worker
+    # has stopped, so it is stale.
+    lock.remove_stale_temporaries(CACHE_FOLDERS)
 
     failed = known_failures | {r["name"]: r["reason"] for r in results if not r["ok"]}
     built = [p for p in plans if p.garment not in failed_garments and p.name not in failed

@@ -45,7 +45,13 @@ class DataConfig:
         drape_frames: frame cap of the drape that makes every template (the design
             settled on the still rest body).
         drape_rest_speed: a drape is at rest when no vertex moves this far in a frame [m].
-        workers: simulation processes (0 = one per core).
+        workers: simulation processes (0 = one per core); with ``executor: ray`` the most
+            tasks in flight (0 = as many as the cluster has CPUs).
+        executor: where the workers run: ``local`` (a process pool on this machine) or
+            ``ray`` (Ray tasks; needs ``pip install -e .[ray]``). The output is the same.
+        ray_address: the Ray cluster to join with ``executor: ray`` (``auto``,
+            ``HOST:6379``, ``ray://HOST:10001``); empty: the one ``RAY_ADDRESS`` names,
+            else one started with ``ray start`` on this machine, else a new Ray here.
         splits: held-out counts.
     """
 
@@ -72,11 +78,14 @@ class DataConfig:
     drape_frames: int = 120
     drape_rest_speed: float = 0.001
     workers: int = 0
+    executor: str = "local"
+    ray_address: str = ""
     splits: SplitConfig = field(default_factory=SplitConfig)
 
     def __post_init__(self) -> None:
         """Check names and ranges before any work starts (a build with an unknown motion
         would otherwise run and leave every sequence out)."""
+        from data_prep.executor import EXECUTORS
         from data_prep.garments import GARMENT_TYPES
         from data_prep.simulate.fabrics import FABRICS
         from gnngarment.body.anny_model import ANNY_PRESETS
@@ -106,3 +115,9 @@ class DataConfig:
             raise ValueError(f"key 'settle_frames': must be >= -1, got {self.settle_frames}")
         if self.workers < 0:
             raise ValueError(f"key 'workers': must be >= 0, got {self.workers}")
+        if self.executor not in EXECUTORS:
+            raise ValueError(f"key 'executor': unknown '{self.executor}'; known: "
+                             f"{', '.join(EXECUTORS)}")
+        if self.ray_address and self.executor != "ray":
+            raise ValueError(f"key 'ray_address': '{self.ray_address}' is only used with "
+                             f"executor: ray, not {self.executor}")

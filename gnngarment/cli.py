@@ -174,8 +174,9 @@ def _rest_state(pos, faces, garment_mesh: Path) -> dict:
 def prepare(
     config: Annotated[Path | None, typer.Option(help="Dataset YAML (configs/data/*.yaml).")
                       ] = None,
-    workers: Annotated[int | None, typer.Option(help="Simulation processes (default: cores).")
-                       ] = None,
+    workers: Annotated[int | None, typer.Option(
+        help="Simulation processes (default: cores); with --executor ray, the most tasks at "
+             "once (default: the cluster's CPUs).")] = None,
     from_cloth3d: Annotated[Path | None, typer.Option(
         "--from-cloth3d", help="Build the cache from a CLOTH3D folder instead.")] = None,
     smpl_model: Annotated[Path | None, typer.Option(
@@ -190,6 +191,14 @@ def prepare(
                                ] = None,
     output: Annotated[Path | None, typer.Option(help="Cache folder (overrides the config).")
                       ] = None,
+    executor: Annotated[str | None, typer.Option(
+        help="Where the simulations run: local (a process pool, the default) or ray (Ray "
+             "tasks on a cluster; pip install -e '.[ray]'). Overrides the config.")] = None,
+    address: Annotated[str | None, typer.Option(
+        help="Ray cluster to join with --executor ray: auto, HOST:6379 or "
+             "ray://HOST:10001 (default: RAY_ADDRESS, else a `ray start` cluster of this "
+             "machine, else a new Ray here).")
+                       ] = None,
 ) -> None:
     """Build (or resume) a dataset: simulate with Newton and write the prepared cache."""
     from gnngarment.config import ConfigError, load_config
@@ -212,8 +221,11 @@ def prepare(
         return
     if config is None:
         raise fail("give --config configs/data/<name>.yaml (or --from-cloth3d DIR)")
+    from dataclasses import replace
+
     from data_prep.build import build_dataset
     from data_prep.config import DataConfig
+    from data_prep.ray_executor import RayMissingError
 
     try:
         settings = load_config(config, DataConfig)
@@ -221,8 +233,17 @@ def prepare(
         raise fail(str(error)) from None
     if output is not None:
         settings.output = str(output)
+    try:  # replace() checks the overridden values as the YAML's are
+        settings = replace(settings, executor=executor or settings.executor,
+                           ray_address=settings.ray_address if address is None else address)
+    except ValueError as error:
+        raise fail(f"--executor/--address: {error}") from None
     try:
         report = build_dataset(settings, workers=workers, log=console.print)
+    except RayMissingError as error:
+        from rich.markup import escape
+
+        raise fail(escape(str(error))) from None  # '.[ray]' is not rich markup
     except (ValueError, OSError) as error:
         raise fail(str(error)) from None
     console.print(f"[green]done[/] in {report['seconds']:.0f} s: splits {report['splits']}, "
