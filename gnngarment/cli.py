@@ -71,6 +71,9 @@ def inspect(
         help="Simulate a few frames of the garment on the (average) rest body and say "
              "whether it is at rest (animate expects it draped; else use animate --drape).")
     ] = False,
+    source_body: Annotated[Path | None, typer.Option(
+        help="The body mesh the garment was modelled on: report the fit onto the rest "
+             "body (as animate --source-body) and rest-check the fitted garment.")] = None,
 ) -> None:
     """Validate a garment mesh and print its pooling hierarchy and style descriptor."""
     from gnngarment.geometry.errors import MeshError
@@ -86,6 +89,9 @@ def inspect(
     except MeshError as error:
         raise fail(str(error)) from None
     seconds = {"load": load_seconds, **prepared.seconds}
+    fit = _fit_report(pos, faces, source_body) if source_body is not None else None
+    if fit is not None:
+        pos = fit.pop("pos")
     rest_state = _rest_state(pos, faces, garment_mesh) if rest_check else None
     hierarchy = prepared.hierarchy
     # Each component's centre at every level, in that level's numbering.
@@ -107,6 +113,7 @@ def inspect(
             "descriptor": prepared.descriptor.tolist(),
             "seconds": seconds,
             **({"rest_check": rest_state} if rest_state is not None else {}),
+            **({"fit": fit} if fit is not None else {}),
         }
         print(json.dumps(result, indent=2))
         return
@@ -136,6 +143,8 @@ def inspect(
     console.print(f"style descriptor ({len(descriptor)} Nyström eigenvalues, largest first): "
                   + " ".join(f"{v:.4g}" for v in descriptor[:8]) + " ...")
     console.print("seconds: " + ", ".join(f"{k} {v:.3f}" for k, v in seconds.items()))
+    if fit is not None:
+        console.print(f"[yellow]placement:[/] {fit['message']}")
     if rest_state is not None:
         colour = "green" if rest_state["at_rest"] else "yellow"
         console.print(f"[{colour}]rest check:[/] {rest_state['message']}")
@@ -145,6 +154,32 @@ def inspect(
 #: the garment is "not at rest" (a draped garment creeps ~1 mm in that time).
 REST_CHECK_FRAMES = 5
 REST_CHECK_MOVE = 0.003
+
+
+def _fit_report(pos, faces, source_body: Path) -> dict:
+    """``inspect --source-body``: the garment fitted onto the average rest body and what
+    the fit found (the fitted positions under ``pos``)."""
+    from gnngarment.body import AnnyBodyModel
+    from gnngarment.data.body_inputs import body_shape_inputs
+    from gnngarment.geometry.errors import MeshError
+    from gnngarment.geometry.mesh_io import load_mesh
+    from gnngarment.inference.placement import place_garment
+
+    try:
+        source = load_mesh(source_body)
+    except (MeshError, ValueError) as error:
+        raise fail(str(error)) from None
+    body_model = AnnyBodyModel()
+    body = body_shape_inputs(body_model, body_model.default_shape(), 128)
+    try:
+        placed = place_garment(pos, faces, body, source_body=source)
+    except ValueError as error:
+        raise fail(f"{source_body}: {error}") from None
+    alignment = placed.fitted.alignment
+    return {"pos": placed.pos, "message": placed.messages[0], "scale": alignment.scale,
+            "rotation": alignment.rotation.tolist(),
+            "translation_m": alignment.translation.tolist(),
+            "registration_error_m": placed.fitted.registration_error}
 
 
 def _rest_state(pos, faces, garment_mesh: Path) -> dict:

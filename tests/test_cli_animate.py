@@ -242,3 +242,29 @@ def test_a_file_name_with_a_space_exports(files, tmp_path) -> None:
                                  "pc2", "--no-body"])
     assert result.exit_code == 0, result.output
     assert (tmp_path / "o" / "my_skirt.pc2").is_file()
+
+
+def test_inspect_and_attribute_take_the_source_body(files, anny_body, tmp_path) -> None:
+    """`inspect --source-body` reports the fit (units and up axis of an SMPL-style body
+    file found: ×0.01, Y up); `attribute --source-body` runs on the fitted garment."""
+    import json
+
+    from gnngarment.inference.checks import Z_UP_FROM_Y_UP
+
+    rest = anny_body.rest()
+    pos, faces = load_mesh(files["garment"])
+    body_file, garment_file = tmp_path / "body_cm.obj", tmp_path / "skirt_cm_y.obj"
+    trimesh.Trimesh(100 * rest.vertices.numpy() @ Z_UP_FROM_Y_UP, anny_body.faces,
+                    process=False).export(body_file)
+    trimesh.Trimesh(100 * pos @ Z_UP_FROM_Y_UP, faces, process=False).export(garment_file)
+    result = runner.invoke(app, ["inspect", str(garment_file), "--source-body", str(body_file),
+                                 "--json"])
+    assert result.exit_code == 0, result.output
+    fit = json.loads(result.output[result.output.index("{"):])["fit"]
+    assert abs(fit["scale"] - 0.01) < 2e-4
+    np.testing.assert_allclose(fit["rotation"], Z_UP_FROM_Y_UP)
+    heat = runner.invoke(app, ["attribute", str(files["checkpoint"]), str(garment_file),
+                               "--source-body", str(body_file), "--out", str(tmp_path / "h"),
+                               "--n-steps", "2", "--duration", "0.2"])
+    assert heat.exit_code == 0, heat.output
+    assert "fitted from the source body" in " ".join(heat.output.split())

@@ -166,6 +166,9 @@ def attribute_command(
         "BVH's (docs/motions.md).")] = None,
     motion_up_axis: Annotated[str, typer.Option(
         "--motion-up-axis", help="Up axis of a .npz/.bvh motion: auto, y or z.")] = "auto",
+    source_body: Annotated[Path | None, typer.Option(
+        "--source-body", help="The body mesh the garment was modelled on: the garment is "
+        "fitted from it onto the rest body first (as animate --source-body).")] = None,
 ) -> None:
     """Integrated-gradient heatmap (paper Eq. 9) of a predicted deformation: PNG, PLY,
     NPZ and JSON in --out."""
@@ -193,6 +196,7 @@ def attribute_command(
     try:
         model = load_model(checkpoint)
         pos, faces = load_mesh(garment_mesh)
+        source = None if source_body is None else load_mesh(source_body)
     except (ValueError, MeshError) as error:
         _fail(str(error))
     try:
@@ -208,6 +212,15 @@ def attribute_command(
                    else {"duration": duration})), count)
     except (MotionError, SMPLModelError, ValueError) as error:
         _fail(str(error))
+    if source is not None:
+        from gnngarment.inference.placement import place_garment
+
+        try:
+            placed = place_garment(pos, faces, shape_inputs, source_body=source)
+        except ValueError as error:
+            _fail(f"{source_body}: {error}")
+        pos = placed.pos
+        console.print(f"placement: {placed.messages[0]}", highlight=False)
     try:
         with console.status(f"integrated gradients ({n_steps} Gauss-Legendre points)"):
             summary = run_attribution(
