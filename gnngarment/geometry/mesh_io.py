@@ -90,9 +90,9 @@ def read_textured_obj(path: Path) -> TexturedMesh:
                     corners, uv_corners = [], []
                     for word in words[1:]:
                         fields = word.split("/")
-                        corners.append(_obj_index(int(fields[0]), len(positions)))
+                        corners.append(_obj_index(_integer(fields[0]), len(positions)))
                         if len(fields) > 1 and fields[1]:
-                            uv_corners.append(_obj_index(int(fields[1]), len(texcoords)))
+                            uv_corners.append(_obj_index(_integer(fields[1]), len(texcoords)))
                     fan = range(1, len(corners) - 1)
                     triangles.extend([corners[0], corners[k], corners[k + 1]] for k in fan)
                     if len(uv_corners) == len(corners):
@@ -116,6 +116,18 @@ def read_textured_obj(path: Path) -> TexturedMesh:
                         f"{uv_faces.min() + 1}..{uv_faces.max() + 1}, the file has "
                         f"{len(texcoords)}")
     return TexturedMesh(pos, faces, np.asarray(texcoords, dtype=np.float64), uv_faces)
+
+
+def _integer(word: str) -> int:
+    """An OBJ index; CLOTH3D's writer prints them as floats (``6893.0``), which only a
+    whole number may be."""
+    try:
+        return int(word)
+    except ValueError:
+        value = float(word)
+        if not value.is_integer():
+            raise ValueError(f"face index {word!r} is not a whole number") from None
+        return int(value)
 
 
 def _obj_index(index: int, count: int) -> int:

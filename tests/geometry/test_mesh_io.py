@@ -102,3 +102,15 @@ def test_glb_uvs_come_back_per_vertex_in_obj_convention(tmp_path: Path) -> None:
     plain = tmp_path / "plain.ply"
     trimesh.Trimesh(pos, faces, process=False).export(plain)
     assert load_textured_mesh(plain).uv is None
+
+
+def test_obj_face_indices_written_as_floats_are_read(tmp_path: Path) -> None:
+    """CLOTH3D's starter kit writes `f 6893.0 3.0 6892.0`; a fractional index is an error
+    naming the file."""
+    text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1.0 2.0 3.0\nf 2 4.0 3\n"
+    (tmp_path / "floats.obj").write_text(text)
+    _, faces = load_mesh(tmp_path / "floats.obj")
+    np.testing.assert_array_equal(faces, [[0, 1, 2], [1, 3, 2]])
+    (tmp_path / "half.obj").write_text(text.replace("f 2 4.0 3", "f 2 3.5 3"))
+    with pytest.raises(MeshError, match="half.obj.*not a whole number"):
+        load_mesh(tmp_path / "half.obj")
