@@ -19,6 +19,30 @@ class ConfigError(ValueError):
     """A configuration file is missing, unreadable, or does not match its schema."""
 
 
+#: Suffixes :func:`parse_mapping_text` reads.
+MAPPING_SUFFIXES = (".json", ".yaml", ".yml")
+
+
+def parse_mapping_text(text: str, suffix: str) -> Any:
+    """The value of a small user file (a body shape, a joint map): JSON for ``.json``,
+    YAML (OmegaConf, no code execution) for ``.yaml``/``.yml``.
+
+    Raises:
+        KeyError: ``suffix`` is not one of :data:`MAPPING_SUFFIXES`.
+        Exception: the parser's own syntax error (callers name their file).
+    """
+    import json
+
+    suffix = suffix.lower()
+    if suffix == ".json":
+        return json.loads(text)
+    if suffix in (".yaml", ".yml"):
+        from omegaconf import OmegaConf
+
+        return OmegaConf.to_container(OmegaConf.create(text))
+    raise KeyError(suffix)
+
+
 def load_config(path: str | Path, schema: type[T], section: str | None = None) -> T:
     """Load ``path`` (YAML) into an instance of the dataclass ``schema``.
 

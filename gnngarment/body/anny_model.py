@@ -19,7 +19,6 @@ from __future__ import annotations
 import collections
 import dataclasses
 import functools
-import json
 from pathlib import Path
 from typing import Any
 
@@ -79,18 +78,13 @@ class AnnyShape:
         path = Path(path)
         if not path.is_file():
             raise ValueError(f"{path}: shape file not found")
+        from gnngarment.config import MAPPING_SUFFIXES, parse_mapping_text
+
+        if path.suffix.lower() not in MAPPING_SUFFIXES:
+            raise ValueError(f"{path}: unknown shape file type (expected .json, .yaml or .yml)")
         text = path.read_text()
         try:
-            if path.suffix.lower() == ".json":
-                values = json.loads(text)
-            elif path.suffix.lower() in (".yaml", ".yml"):
-                from omegaconf import OmegaConf
-
-                values = OmegaConf.to_container(OmegaConf.create(text))
-            else:
-                raise ValueError("unknown shape file type (expected .json, .yaml or .yml)")
-        except ValueError as error:
-            raise ValueError(f"{path}: {error}") from error
+            values = parse_mapping_text(text, path.suffix)
         except Exception as error:  # yaml/json syntax errors
             raise ValueError(f"{path}: cannot parse ({error})") from error
         if not isinstance(values, dict):

@@ -37,7 +37,6 @@ skeleton with ``"auto"``) is taken as is.
 
 from __future__ import annotations
 
-import json
 import re
 import warnings
 from collections.abc import Mapping
@@ -160,18 +159,13 @@ def read_joint_map(path: str | Path) -> dict[str, str | None]:
     path = Path(path)
     if not path.is_file():
         raise MotionError(f"{path}: joint map file not found")
+    from gnngarment.config import MAPPING_SUFFIXES, parse_mapping_text
+
+    if path.suffix.lower() not in MAPPING_SUFFIXES:
+        raise MotionError(f"{path}: joint map must be a .json, .yaml or .yml file")
     text = path.read_text(errors="replace")
     try:
-        if path.suffix.lower() == ".json":
-            values = json.loads(text)
-        elif path.suffix.lower() in (".yaml", ".yml"):
-            from omegaconf import OmegaConf
-
-            values = OmegaConf.to_container(OmegaConf.create(text))
-        else:
-            raise MotionError(f"{path}: joint map must be a .json, .yaml or .yml file")
-    except MotionError:
-        raise
+        values = parse_mapping_text(text, path.suffix)
     except Exception as error:  # json / yaml syntax errors
         message = " ".join(str(error).split())
         raise MotionError(f"{path}: not a readable joint map ({message})") from error
