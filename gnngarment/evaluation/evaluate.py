@@ -133,8 +133,12 @@ def body_skinning_prediction(dataset: PreparedDataset, name: str,
     return posed.numpy()
 
 
-def sequence_metrics(pred: np.ndarray, dataset: PreparedDataset, name: str) -> dict[str, float]:
-    """Frame-averaged metrics of one predicted sequence against its ground truth."""
+def sequence_metrics(pred: np.ndarray, dataset: PreparedDataset, name: str,
+                     body_mesh: tuple[np.ndarray, np.ndarray] | None = None
+                     ) -> dict[str, float]:
+    """Frame-averaged metrics of one predicted sequence against its ground truth; the
+    collision rate against the posed body mesh ``(vertices (T, N_b, 3), faces)`` when
+    given (:func:`metrics.mesh_collision_rate`), else against the cache's body samples."""
     record = dataset.sequence(name)
     garment = dataset.garment_of(name)
     faces = garment.faces.numpy()
@@ -144,8 +148,9 @@ def sequence_metrics(pred: np.ndarray, dataset: PreparedDataset, name: str) -> d
     return {
         "e_verts_mm": 1000 * float(metrics.vertex_error(pred, target).mean()),
         "e_norm_deg": float(metrics.normal_error(pred, target, faces).mean()),
-        "collision_pct": float(metrics.collision_rate(pred, record.body_points,
-                                                      record.body_normals).mean()),
+        "collision_pct": float(
+            metrics.mesh_collision_rate(pred, *body_mesh).mean() if body_mesh is not None
+            else metrics.collision_rate(pred, record.body_points, record.body_normals).mean()),
         "hausdorff_mm": 1000 * float(metrics.hausdorff_distance(pred, target).mean()),
         "sted": float(metrics.spatio_temporal_edge_difference(pred, target, edges, rest).mean()),
     }
@@ -160,22 +165,18 @@ def resolved_sequence_metrics(pred: np.ndarray, dataset: PreparedDataset, name: 
     both collision figures are against it (:func:`metrics.mesh_collision_rate`); without
     one nothing is resolved, the metrics equal the raw ones and collisions are measured
     against the cache's body samples."""
-    raw = sequence_metrics(pred, dataset, name)
+    if body_mesh is not None and len(body_mesh[0]) != len(pred):
+        raise ValueError(f"{name}: the posed body has {len(body_mesh[0])} frames, the "
+                         f"garment {len(pred)}")
+    # With the body mesh at hand, inside means inside the mesh (exact), for the
+    # network's output and for what users get alike.
+    raw = sequence_metrics(pred, dataset, name, body_mesh)
     values = raw
     if body_mesh is not None:
         vertices, body_faces = body_mesh
-        if len(vertices) != len(pred):
-            raise ValueError(f"{name}: the posed body has {len(vertices)} frames, the "
-                             f"garment {len(pred)}")
         resolved, _ = resolve_collisions(pred, dataset.garment_of(name).faces.numpy(),
                                          vertices, body_faces, settings)
-        values = sequence_metrics(resolved, dataset, name)
-        # With the body mesh at hand, inside means inside the mesh (exact), for the
-        # network's output and for what users get alike.
-        raw = {**raw, "collision_pct": float(metrics.mesh_collision_rate(
-            pred, vertices, body_faces).mean())}
-        values = {**values, "collision_pct": float(metrics.mesh_collision_rate(
-            resolved, vertices, body_faces).mean())}
+        values = sequence_metrics(resolved, dataset, name, body_mesh)
     return {**values, "raw_e_verts_mm": raw["e_verts_mm"],
             "raw_collision_pct": raw["collision_pct"]}
 
