@@ -45,11 +45,10 @@ def write_rest_body(out: Path, rest, faces: np.ndarray) -> None:
 
     from gnngarment.body.skeleton import JOINT_NAMES
     from gnngarment.geometry.files import atomic_write_bytes
+    from gnngarment.inference.export.obj_sequence import write_obj
 
-    vertices = rest.vertices.numpy()
-    text = ("v %.6f %.6f %.6f\n" * len(vertices)) % tuple(vertices.ravel().tolist())
-    text += ("f %d %d %d\n" * len(faces)) % tuple((np.asarray(faces) + 1).ravel().tolist())
-    atomic_write_bytes(out / "rest_body.obj", text.encode())
+    write_obj(out / "rest_body.obj", rest.vertices.numpy(), np.asarray(faces),
+              header="rest body (metres, Z up, facing -Y)")
     joints = {name: [round(float(c), 6) for c in position]
               for name, position in zip(JOINT_NAMES, rest.joints.numpy(), strict=True)}
     atomic_write_bytes(out / "rest_joints.json", json.dumps(joints, indent=1).encode())
