@@ -89,10 +89,11 @@ def inspect(
     except MeshError as error:
         raise fail(str(error)) from None
     seconds = {"load": load_seconds, **prepared.seconds}
-    fit = _fit_report(pos, faces, source_body) if source_body is not None else None
+    rest_body = _average_rest_body() if source_body is not None or rest_check else None
+    fit = _fit_report(pos, faces, source_body, rest_body) if source_body is not None else None
     if fit is not None:
         pos = fit.pop("pos")
-    rest_state = _rest_state(pos, faces, garment_mesh) if rest_check else None
+    rest_state = _rest_state(pos, faces, garment_mesh, rest_body) if rest_check else None
     hierarchy = prepared.hierarchy
     # Each component's centre at every level, in that level's numbering.
     centres = [level.centres.tolist() for level in hierarchy.levels]
@@ -156,11 +157,19 @@ REST_CHECK_FRAMES = 5
 REST_CHECK_MOVE = 0.003
 
 
-def _fit_report(pos, faces, source_body: Path) -> dict:
-    """``inspect --source-body``: the garment fitted onto the average rest body and what
-    the fit found (the fitted positions under ``pos``)."""
+def _average_rest_body():
+    """The average Anny rest body as :class:`BodyShapeInputs` (what ``inspect`` checks a
+    garment against)."""
     from gnngarment.body import AnnyBodyModel
     from gnngarment.data.body_inputs import body_shape_inputs
+
+    body_model = AnnyBodyModel()
+    return body_shape_inputs(body_model, body_model.default_shape(), 128)
+
+
+def _fit_report(pos, faces, source_body: Path, body) -> dict:
+    """``inspect --source-body``: the garment fitted onto the rest ``body`` and what the
+    fit found (the fitted positions under ``pos``)."""
     from gnngarment.geometry.errors import MeshError
     from gnngarment.geometry.mesh_io import load_mesh
     from gnngarment.inference.placement import place_garment
@@ -169,8 +178,6 @@ def _fit_report(pos, faces, source_body: Path) -> dict:
         source = load_mesh(source_body)
     except (MeshError, ValueError) as error:
         raise fail(str(error)) from None
-    body_model = AnnyBodyModel()
-    body = body_shape_inputs(body_model, body_model.default_shape(), 128)
     try:
         placed = place_garment(pos, faces, body, source_body=source)
     except ValueError as error:
@@ -182,16 +189,13 @@ def _fit_report(pos, faces, source_body: Path) -> dict:
             "registration_error_m": placed.fitted.registration_error}
 
 
-def _rest_state(pos, faces, garment_mesh: Path) -> dict:
-    """Simulate :data:`REST_CHECK_FRAMES` frames of the garment on the average rest
-    body (as given: metres, Z up) and report how far it moves."""
+def _rest_state(pos, faces, garment_mesh: Path, body) -> dict:
+    """Simulate :data:`REST_CHECK_FRAMES` frames of the garment on the rest ``body`` (as
+    given: metres, Z up) and report how far it moves."""
     from data_prep.simulate import SimulationFailed, drape_garment
-    from gnngarment.body import AnnyBodyModel
 
-    body_model = AnnyBodyModel()
-    rest = body_model.rest(body_model.default_shape())
     try:
-        result = drape_garment(pos, faces, rest.vertices.numpy(), body_model.faces,
+        result = drape_garment(pos, faces, body.rest_vertices, body.faces,
                                max_frames=REST_CHECK_FRAMES)
     except (ValueError, SimulationFailed) as error:
         raise fail(f"{garment_mesh}: the rest check could not simulate it: {error}") from None
