@@ -92,10 +92,15 @@ class DesignPlan:
 
 @dataclass(frozen=True)
 class MotionPlan:
+    """One motion of the build: a library motion, its seed and, for a variant, its
+    tempo (``speed``) and joint-angle (``amplitude``) multipliers."""
+
     name: str
     motion: str
     seed: int
     split: str
+    speed: float = 1.0
+    amplitude: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -149,14 +154,19 @@ def plan_dataset(config: DataConfig) -> list[SequencePlan]:
     motion_split = _assign(len(config.motions), splits.val_motions, splits.test_motions)
     motions = [MotionPlan(f"{name}{k:02d}", name, int(rng.integers(1 << 30)), motion_split[k])
                for k, name in enumerate(config.motions)]
+    train_motions = [m for m in motions if m.split == "train"]
 
     sequences = []
-    train_motions = [m for m in motions if m.split == "train"]
     for design in designs:
         for b, body in enumerate(bodies):
             if design.split == "train" and body.split == "train":
                 for j in range(config.motions_per_pair):
+                    # The first motions of a pair are the canonical ones (so adding
+                    # variants to a config keeps every sequence it already had).
                     motion = train_motions[(b + j + designs.index(design)) % len(train_motions)]
+                    variant = j * config.motion_variants // config.motions_per_pair
+                    if variant:
+                        motion = _motion_variant(motion, variant, (config.seed, design.seed, b))
                     sequences.append(SequencePlan(f"{design.name}_{body.name}_{motion.name}",
                                                   design, body, motion, "train"))
             elif design.split != "train" and body.split == design.split:
@@ -164,7 +174,73 @@ def plan_dataset(config: DataConfig) -> list[SequencePlan]:
                 motion = held_out[designs.index(design) % len(held_out)]
                 sequences.append(SequencePlan(f"{design.name}_{body.name}_{motion.name}",
                                               design, body, motion, design.split))
+    repeated = len(sequences) - len({plan.name for plan in sequences})
+    if repeated:
+        raise ValueError(
+            f"key 'motions_per_pair': {config.motions_per_pair} motions per pair repeat a "
+            f"motion ({repeated} sequences planned twice); there are {len(train_motions)} "
+            f"train motions, each in {config.motion_variants} variant(s)")
     return sequences
+
+
+#: Variant tempo and joint-angle multipliers are drawn from these ranges (the amplitude
+#: stays under the library's tested 1.2 after its own ±10 % jitter).
+VARIANT_SPEED = (0.75, 1.35)
+VARIANT_AMPLITUDE = (0.7, 1.05)
+
+
+def _motion_variant(motion: MotionPlan, variant: int, key: tuple[int, ...]) -> MotionPlan:
+    """Variant ``variant`` (>= 1) of a train motion for one (design, body) pair (``key``):
+    the same library motion at its own tempo, amplitude and seed, so every sequence
+    that has one moves differently. Drawn from a generator of its own, so the draws of
+    the canonical plan are unchanged."""
+    rng = np.random.default_rng([*key, motion.seed, variant])
+    return MotionPlan(f"{motion.name}v{variant}", motion.motion, int(rng.integers(1 << 30)),
+                      motion.split, speed=round(float(rng.uniform(*VARIANT_SPEED)), 3),
+                      amplitude=round(float(rng.uniform(*VARIANT_AMPLITUDE)), 3))
+
+
+def planned_motion(plan: MotionPlan, config: DataConfig):
+    """The :class:`~gnngarment.body.motion.Motion` a plan stands for (``config`` gives its
+    length and frame rate)."""
+    from gnngarment.body.procedural import make_motion
+
+    return make_motion(plan.motion, duration=config.motion_seconds, fps=config.fps,
+                       speed=plan.speed, amplitude=plan.amplitude, seed=plan.seed)
+
+
+#: Config keys that only decide *which* garments, bodies and motions are planned: their
+#: effect on a sequence is all in its plan (hashed with it), so changing them (e.g. more
+#: motions per pair) keeps every sequence and drape already built.
+PLAN_KEYS = ("seed", "garment_types", "garments", "garment_vertices", "bodies",
+             "body_presets", "motions", "motions_per_pair", "motion_variants", "fabrics",
+             "splits")
+#: Config keys that decide nothing a worker computes.
+PLACE_KEYS = ("output", "workers", "simulation", "executor", "ray_address")
+
+
+def _plan_fields(plan: Any) -> dict[str, Any]:
+    """A plan's hashed fields; a canonical motion hashes as before variants existed."""
+    fields = asdict(plan)
+    for motion in [fields] if isinstance(plan, MotionPlan) else (
+            [fields["motion"]] if isinstance(plan, SequencePlan) else []):
+        for key in ("speed", "amplitude"):
+            if motion[key] == 1.0:
+                del motion[key]
+    return fields
+
+
+def content_inputs(config: DataConfig, settings: Any) -> dict[str, Any]:
+    """What every sequence's and drape's content depends on besides its own plan: not
+    where the dataset lives, how many processes build it or where, the path of the
+    simulation file (its ``settings`` are hashed), nor what only chooses the plans."""
+    content = {k: v for k, v in asdict(config).items() if k not in PLACE_KEYS + PLAN_KEYS}
+    return {"builder": BUILDER_VERSION, "config": content, "simulation": asdict(settings)}
+
+
+def sequence_inputs_hash(inputs: dict[str, Any], plan: SequencePlan) -> str:
+    """The hash a built sequence is recorded with (its ``.hash`` file)."""
+    return _hash({**inputs, "plan": _plan_fields(plan)})
 
 
 def _hash(payload: Any) -> str:
@@ -339,15 +415,13 @@ def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[s
         from data_prep.cloth3d import write_sequence as write_cloth3d
         from data_prep.simulate import SimulationFailed, load_simulation_settings, simulate_garment
         from gnngarment.body.features import motion_features
-        from gnngarment.body.procedural import make_motion
         from gnngarment.data.cache import SequenceRecord, read_garment, write_sequence
         from gnngarment.geometry.normals import vertex_normals
 
         torch.set_num_threads(1)
         body_model = _body_model()
         shape = _shape(plan.body)
-        motion = make_motion(plan.motion.motion, duration=config.motion_seconds, fps=config.fps,
-                             seed=plan.motion.seed)
+        motion = planned_motion(plan.motion, config)
         with torch.no_grad():
             posed = body_model.pose(motion, shape)
         body_vertices = posed.vertices.numpy()
@@ -524,12 +598,7 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
     started = time.perf_counter()
     plans = plan_dataset(config)
     settings = load_simulation_settings(config.simulation)
-    # What decides a sequence's content: not where the dataset lives, how many
-    # processes build it or where, or the path of the simulation file (its settings are
-    # hashed).
-    content = {k: v for k, v in asdict(config).items()
-               if k not in ("output", "workers", "simulation", "executor", "ray_address")}
-    base_hash = {"builder": BUILDER_VERSION, "config": content, "simulation": asdict(settings)}
+    base_hash = content_inputs(config, settings)
 
     bodies = {p.body.name: p.body for p in plans}
     for plan in tqdm(bodies.values(), desc="bodies", unit="body"):
@@ -573,7 +642,7 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
         for plan in plans:
             if plan.garment in failed_garments:
                 continue
-            inputs_hash = _hash({**base_hash, "plan": asdict(plan)})
+            inputs_hash = sequence_inputs_hash(base_hash, plan)
             if _sequence_done(root, plan.name, inputs_hash):
                 skipped += 1
                 continue

@@ -34,6 +34,9 @@ class DataConfig:
         motions: procedural motion names (train + held out; held-out ones are the last).
         motion_seconds: length of every motion (s); fps: frames per second.
         motions_per_pair: train motions simulated per (design, body) pair.
+        motion_variants: versions of every train motion (1 = the canonical one only);
+            each further variant has its own seeded tempo and amplitude, and takes the
+            last ``(variants - 1) / variants`` of a pair's motions.
         fabrics: fabrics to cycle through (CLOTH3D names).
         body_vertices: ``N_b'`` feature subset size; collision_points: body samples
             stored per frame for the collision loss and rate.
@@ -68,6 +71,7 @@ class DataConfig:
     motion_seconds: float = 2.0
     fps: float = 30.0
     motions_per_pair: int = 1
+    motion_variants: int = 1
     fabrics: list[str] = field(default_factory=lambda: ["cotton", "silk", "denim", "leather"])
     body_vertices: int = 128
     collision_points: int = 2048
@@ -107,10 +111,13 @@ class DataConfig:
             value = getattr(self, key)
             if not value > 0 or value != value or value == float("inf"):
                 raise ValueError(f"key '{key}': must be a finite number > 0, got {value}")
-        for key in ("garments", "bodies", "motions_per_pair", "body_vertices",
+        for key in ("garments", "bodies", "motions_per_pair", "motion_variants", "body_vertices",
                     "collision_points", "levels", "landmarks", "drape_frames"):
             if getattr(self, key) < 1:
                 raise ValueError(f"key '{key}': must be >= 1, got {getattr(self, key)}")
+        if self.motion_variants > self.motions_per_pair:
+            raise ValueError(f"key 'motion_variants': {self.motion_variants} variants need at "
+                             f"least as many motions per pair, got {self.motions_per_pair}")
         if self.settle_frames < -1:
             raise ValueError(f"key 'settle_frames': must be >= -1, got {self.settle_frames}")
         if self.workers < 0:

@@ -31,7 +31,7 @@ def synthetic_body_meshes(root: str | Path) -> Callable[[str], BodyMesh | None]:
 
     Anny is constructed on the first call (about a second with its cache in place).
     """
-    from data_prep.build import plan_dataset
+    from data_prep.build import plan_dataset, planned_motion
     from data_prep.config import DataConfig
     from gnngarment.config import ConfigError, merge_config
     from gnngarment.data.cache import read_manifest, read_sequence
@@ -53,16 +53,13 @@ def synthetic_body_meshes(root: str | Path) -> Callable[[str], BodyMesh | None]:
         import torch
 
         from gnngarment.body.anny_model import AnnyBodyModel, AnnyShape
-        from gnngarment.body.procedural import make_motion
-
         plan = plans.get(name)
         if plan is None:
             return None
         if "model" not in state:
             state["model"] = AnnyBodyModel()
         model = state["model"]
-        motion = make_motion(plan.motion.motion, duration=config.motion_seconds,
-                             fps=config.fps, seed=plan.motion.seed)
+        motion = planned_motion(plan.motion, config)
         with torch.no_grad():
             vertices = model.pose(motion, AnnyShape(**plan.body.shape)).vertices.numpy()
         stored = read_sequence(root, name).body_points

@@ -22,8 +22,10 @@ from data_prep.build import (
     _left_out,
     _sequence_done,
     build_dataset,
+    content_inputs,
     left_the_body,
     plan_dataset,
+    sequence_inputs_hash,
 )
 from data_prep.config import DataConfig
 from gnngarment.config import load_config
@@ -53,6 +55,32 @@ def test_plan_holds_out_garments_bodies_and_motions(tmp_path: Path) -> None:
         for attribute in ("design", "body", "motion"):
             seen = {getattr(p, attribute).name for p in train}
             assert not {getattr(p, attribute).name for p in held} & seen, (split, attribute)
+
+
+def test_more_motions_per_pair_keeps_every_built_sequence(tmp_path: Path) -> None:
+    """Growing a dataset (more motions per pair, motion variants) plans every sequence it
+    had with the same inputs hash, so a resumed build simulates only the new ones; each
+    new variant moves at a tempo and amplitude of its own."""
+    from data_prep.simulate import load_simulation_settings
+
+    config = tiny_config(tmp_path)
+    grown = replace(config, motions_per_pair=config.motions_per_pair + 1, motion_variants=2)
+    settings = load_simulation_settings(config.simulation)
+    before = {p.name: sequence_inputs_hash(content_inputs(config, settings), p)
+              for p in plan_dataset(config)}
+    after = {p.name: p for p in plan_dataset(grown)}
+    hashes = {name: sequence_inputs_hash(content_inputs(grown, settings), p)
+              for name, p in after.items()}
+    assert all(hashes[name] == value for name, value in before.items())
+    variants = [p.motion for p in after.values() if p.motion.speed != 1.0]
+    assert len(variants) == len(after) - len(before) > 1
+    assert len({(m.speed, m.amplitude, m.seed) for m in variants}) == len(variants)
+    with pytest.raises(ValueError, match="motions_per_pair"):  # a motion twice per pair
+        plan_dataset(replace(config, motions_per_pair=config.motions_per_pair + 1))
+    # a change that alters what is simulated changes every hash
+    slower = replace(config, fps=config.fps / 2)
+    assert not any(sequence_inputs_hash(content_inputs(slower, settings), p) == before[p.name]
+                   for p in plan_dataset(slower))
 
 
 def test_recorded_failure_is_tied_to_its_inputs(tmp_path: Path) -> None:
