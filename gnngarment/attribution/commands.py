@@ -169,6 +169,9 @@ def attribute_command(
     source_body: Annotated[Path | None, typer.Option(
         "--source-body", help="The body mesh the garment was modelled on: the garment is "
         "fitted from it onto the rest body first (as animate --source-body).")] = None,
+    ignore_placement: Annotated[bool, typer.Option(
+        help="Attribute even if the garment does not sit on the rest body (the heatmap of "
+        "a misplaced garment explains a deformation it would never get).")] = False,
 ) -> None:
     """Integrated-gradient heatmap (paper Eq. 9) of a predicted deformation: PNG, PLY,
     NPZ and JSON in --out."""
@@ -221,6 +224,14 @@ def attribute_command(
             _fail(f"{source_body}: {error}")
         pos = placed.pos
         console.print(f"placement: {placed.messages[0]}", highlight=False)
+    from gnngarment.inference.checks import check_garment_placement
+
+    findings = check_garment_placement(pos, faces, shape_inputs.rest_vertices, shape_inputs.faces)
+    for finding in findings:
+        console.print(f"{finding.severity}: {garment_mesh}: {finding.message}", highlight=False)
+    if any(f.severity == "error" for f in findings) and not ignore_placement:
+        _fail(f"{garment_mesh}: the garment is not on the rest body (see above; fix it or "
+              "pass --source-body or --ignore-placement)")
     try:
         with console.status(f"integrated gradients ({n_steps} Gauss-Legendre points)"):
             summary = run_attribution(
