@@ -9,6 +9,8 @@ files, whether on 2 cores or 200.
 from __future__ import annotations
 
 import multiprocessing
+import os
+import sys
 from collections.abc import Callable, Iterator
 from typing import Any, Protocol
 
@@ -49,6 +51,26 @@ class Executor(Protocol):
     def __exit__(self, *exc_info: object) -> None: ...
 
 
+def stop_with_parent(parent: int) -> None:
+    """Pool-worker initializer: end this worker when the build that started it dies.
+
+    A build killed with SIGKILL cannot terminate its pool, and a worker would go on
+    simulating (and writing into the cache) for the rest of its task. On Linux the
+    kernel sends the worker SIGKILL when its parent dies (``PR_SET_PDEATHSIG``); if the
+    parent is already gone by the time this runs, the worker exits at once. Elsewhere
+    the worker finishes its task alone (the next build's lock and temp-file cleanup
+    still hold).
+    """
+    if sys.platform.startswith("linux"):
+        import ctypes
+        import signal
+
+        set_parent_death_signal = 1  # PR_SET_PDEATHSIG, <linux/prctl.h>
+        ctypes.CDLL(None, use_errno=True).prctl(set_parent_death_signal, signal.SIGKILL)
+    if os.getppid() != parent:
+        os._exit(1)
+
+
 class LocalExecutor:
     """A ``spawn`` process pool on this machine, made at the first non-empty map with
     ``min(workers, len(tasks))`` processes and reused by the later maps (so each worker
@@ -65,7 +87,9 @@ class LocalExecutor:
         if not tasks:
             return iter(())
         if self._pool is None:
-            self._pool = multiprocessing.get_context("spawn").Pool(self.parallelism(len(tasks)))
+            self._pool = multiprocessing.get_context("spawn").Pool(
+                self.parallelism(len(tasks)), initializer=stop_with_parent,
+                initargs=(os.getpid(),))
         return self._pool.imap_unordered(function, tasks)
 
     def parallelism(self, tasks: int) -> int:
@@ -104,8 +128,6 @@ def make_executor(kind: str, workers: int | None, address: str = "") -> Executor
         RayMissingError: ``kind="ray"`` and Ray is not installed (an ``ImportError``).
     """
     if kind == "local":
-        import os
-
         return LocalExecutor(workers or os.cpu_count() or 1)
     if kind == "ray":
         from data_prep.ray_executor import RayExecutor

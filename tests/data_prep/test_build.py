@@ -127,11 +127,28 @@ def test_a_garment_that_slides_down_the_body_is_caught() -> None:
     assert left_the_body(np.stack([rest, rest + down(0.4)]), squat, rest=rest) == ""
 
 
+def _children(pid: int) -> list[int]:
+    """Processes whose parent is ``pid`` (Linux ``/proc``)."""
+    found = []
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        found += [int(child) for child in (task / "children").read_text().split()]
+    return found
+
+
+def _alive(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie, reaped by init later, has stopped)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().split(")")[-1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
 @pytest.mark.slow
 def test_build_killed_mid_way_resumes(tmp_path: Path) -> None:
-    """Start `gnngarment prepare` with one worker, SIGKILL its whole process group as
-    soon as the first sequence is written, rebuild: finished sequences are skipped, the
-    rest are simulated, and every sequence in the manifest reads back complete."""
+    """Start `gnngarment prepare` with one worker, SIGKILL the builder as soon as the
+    first sequence is written: its worker stops with it (it does not go on writing into
+    the cache). Rebuild: finished sequences are skipped, the rest are simulated, and
+    every sequence in the manifest reads back complete."""
     config = tiny_config(tmp_path / "data")
     config_file = tmp_path / "tiny.yaml"
     config_file.write_text(OmegaConf.to_yaml(OmegaConf.create(asdict(config))))
@@ -146,8 +163,16 @@ def test_build_killed_mid_way_resumes(tmp_path: Path) -> None:
             assert process.poll() is None, "the build ended before it could be killed"
             assert time.monotonic() < deadline, "no sequence written in 10 minutes"
             time.sleep(0.05)
+        workers = _children(process.pid)
+        os.kill(process.pid, signal.SIGKILL)  # the builder alone, as `kill -9` does
+        process.wait()
+        stopped = time.monotonic() + 5.0
+        while any(_alive(pid) for pid in workers) and time.monotonic() < stopped:
+            time.sleep(0.05)
+        assert workers and not any(_alive(pid) for pid in workers), \
+            "a simulation worker outlived its killed build"
     finally:
-        os.killpg(process.pid, signal.SIGKILL)  # the builder and its simulation worker
+        os.killpg(process.pid, signal.SIGKILL)  # whatever is left of the process group
         process.wait()
     finished = {p.stem for p in sequences.glob("*.hash")}
     assert not (tmp_path / "data" / "manifest.json").exists()
