@@ -9,7 +9,10 @@ the trainer's (``pairs_per_batch`` garment–body pairs × ``frames_per_pair`` f
 mixed garments).
 
     .venv/bin/python benchmarks/training_speed.py [--config configs/train/demo.yaml]
-        [--data data/demo] [--steps 10] [--threads 1]
+        [--data data/demo] [--steps 10] [--threads 1] [--deterministic on|off|both]
+
+``--deterministic both`` measures the run with torch's deterministic algorithms off and
+on (the training default), in that order in one process, and prints the ratio.
 
 Without a prepared cache at ``--data`` it prints how to build one and exits 2.
 """
@@ -37,16 +40,19 @@ from gnngarment.training.trainer import Trainer, set_stage  # noqa: E402
 STAGES = ("supervised", "physics", "physics_strain")
 
 
-def measure(config_path: Path, data: Path, steps: int, threads: int) -> dict:
+def measure(config_path: Path, data: Path, steps: int, threads: int,
+            deterministic: bool = True) -> dict:
     """Seconds per optimiser step (:meth:`Trainer.step`) for each stage, the first step of
     each stage discarded as a warm-up. Returns a JSON-able dict."""
-    config = load_training_config(config_path, [f"data={data}", f"threads={threads}"])
+    config = load_training_config(config_path, [f"data={data}", f"threads={threads}",
+                                                f"deterministic={deterministic}"])
     dataset = PreparedDataset(config.data, "train", config.model.window)
     trainer = Trainer(config, dataset, None, progress=False)
     trainer.step_module.train()
     rng = np.random.default_rng(config.seed)
     groups = list(dataset.batches(config.pairs_per_batch, config.frames_per_pair, rng))
     results = {"config": str(config_path), "data": str(data), "threads": threads,
+               "deterministic": deterministic,
                "pairs_per_batch": config.pairs_per_batch,
                "frames_per_pair": config.frames_per_pair, "stages": {}}
     for stage in STAGES:
@@ -77,6 +83,7 @@ def main() -> None:
     parser.add_argument("--data", type=Path, default=ROOT / "data/demo")
     parser.add_argument("--steps", type=int, default=10)
     parser.add_argument("--threads", type=int, default=1)
+    parser.add_argument("--deterministic", choices=("on", "off", "both"), default="on")
     parser.add_argument("--json", type=Path, help="also write the results here")
     args = parser.parse_args()
     if not (args.data / "manifest.json").is_file():
@@ -85,16 +92,25 @@ def main() -> None:
         raise SystemExit(2)
     print(f"torch {torch.__version__}, {args.threads} thread(s), load average "
           f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
-    results = measure(args.config, args.data, args.steps, args.threads)
-    print(f"{results['pairs_per_batch']} pairs × {results['frames_per_pair']} frames per "
-          f"batch, {args.steps} steps per stage after one warm-up step, {args.data}")
-    print("| stage | s/step (mean) | s/step (median) | frames/s | vertices/s |")
-    print("|---|---|---|---|---|")
-    for stage, row in results["stages"].items():
-        print(f"| {stage} | {row['seconds_per_step']:.3f} | {row['median_seconds_per_step']:.3f}"
-              f" | {row['frames_per_second']:.1f} | {row['vertices_per_second']:.0f} |")
+    modes = {"on": [True], "off": [False], "both": [False, True]}[args.deterministic]
+    runs = [measure(args.config, args.data, args.steps, args.threads, mode) for mode in modes]
+    for results in runs:
+        print(f"{results['pairs_per_batch']} pairs × {results['frames_per_pair']} frames per "
+              f"batch, {args.steps} steps per stage after one warm-up step, {args.data}, "
+              f"deterministic {'on' if results['deterministic'] else 'off'}")
+        print("| stage | s/step (mean) | s/step (median) | frames/s | vertices/s |")
+        print("|---|---|---|---|---|")
+        for stage, row in results["stages"].items():
+            print(f"| {stage} | {row['seconds_per_step']:.3f} | "
+                  f"{row['median_seconds_per_step']:.3f} | {row['frames_per_second']:.1f} | "
+                  f"{row['vertices_per_second']:.0f} |")
+    if len(runs) == 2:
+        median = "median_seconds_per_step"
+        ratios = ", ".join(f"{stage} {runs[1]['stages'][stage][median] / row[median]:.2f}x"
+                           for stage, row in runs[0]["stages"].items())
+        print(f"deterministic on / off, median s/step: {ratios}")
     if args.json:
-        args.json.write_text(json.dumps(results, indent=2))
+        args.json.write_text(json.dumps(runs if len(runs) == 2 else runs[0], indent=2))
 
 
 if __name__ == "__main__":

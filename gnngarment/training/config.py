@@ -80,6 +80,10 @@ class TrainingConfig:
         collision_margin: ε of the collision term (metres).
         threads: torch intra-op threads (0 = torch's default).
         validate_every: epochs between validation passes.
+        deterministic: torch's deterministic algorithms (its scatter/index-add
+            reductions otherwise sum in a thread-dependent order): two runs of one
+            config and seed give bitwise-equal weights with any thread count
+            (docs/reliability.md has the measured cost).
     """
 
     data: str = "data/paper"
@@ -95,6 +99,7 @@ class TrainingConfig:
     collision_margin: float = 0.004
     threads: int = 0
     validate_every: int = 1
+    deterministic: bool = True
 
     def __post_init__(self) -> None:
         """Check ranges before any work starts (``epochs: 0`` would report a checkpoint

@@ -88,6 +88,9 @@ class Trainer:
         self.output = Path(config.output)
         if config.threads:
             torch.set_num_threads(config.threads)
+        # Process-wide, as torch has it; a trainer sets it either way, so one run's
+        # choice does not leak into the next in the same process.
+        torch.use_deterministic_algorithms(config.deterministic)
         torch.manual_seed(config.seed)
         self.model = GarmentDeformer(config.model)
         self.step_module: nn.Module = TrainingStep(self.model)

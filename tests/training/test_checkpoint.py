@@ -65,6 +65,7 @@ def test_every_checkpoint_records_threads_and_library_versions(model: GarmentDef
     save_checkpoint(path, model_payload(model))
     environment = load_checkpoint(path)["environment"]
     assert environment["torch_threads"] == torch.get_num_threads()
+    assert environment["deterministic"] == torch.are_deterministic_algorithms_enabled()
     assert environment["torch"] == torch.__version__
     assert environment["numpy"] == np.__version__
     assert environment["torch_geometric"] == torch_geometric.__version__
