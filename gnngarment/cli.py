@@ -33,7 +33,10 @@ BAD_INPUT = 2
 
 def fail(message: str) -> typer.Exit:
     """Print ``message`` as an error and return the exit to raise."""
-    errors.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
+    from rich.markup import escape
+
+    # Escaped: rich would drop "[low, high]" or ".[ray]" in a message as a markup tag.
+    errors.print(f"[bold red]error:[/] {escape(message)}", highlight=False, soft_wrap=True)
     return typer.Exit(BAD_INPUT)
 
 
@@ -260,11 +263,14 @@ def prepare(
         return
     if config is None:
         raise fail("give --config configs/data/<name>.yaml (or --from-cloth3d DIR)")
+    if workers is not None and workers < 0:  # else refused only after the bodies are built
+        raise fail(f"--workers must be >= 0 (0: one per core), got {workers}")
     from dataclasses import replace
 
-    from data_prep.build import build_dataset
+    from data_prep.build import build_dataset, plan_dataset
     from data_prep.config import DataConfig
     from data_prep.ray_executor import RayMissingError
+    from data_prep.simulate import load_simulation_settings
 
     try:
         settings = load_config(config, DataConfig)
@@ -277,12 +283,15 @@ def prepare(
                            ray_address=settings.ray_address if address is None else address)
     except ValueError as error:
         raise fail(f"--executor/--address: {error}") from None
+    try:  # what the build checks only once it has taken (and made) the output folder
+        plan_dataset(settings)
+        load_simulation_settings(settings.simulation)
+    except ValueError as error:
+        raise fail(f"{config}: {error}") from None
     try:
         report = build_dataset(settings, workers=workers, log=console.print)
     except RayMissingError as error:
-        from rich.markup import escape
-
-        raise fail(escape(str(error))) from None  # '.[ray]' is not rich markup
+        raise fail(str(error)) from None
     except (ValueError, OSError) as error:
         raise fail(str(error)) from None
     console.print(f"[green]done[/] in {report['seconds']:.0f} s: splits {report['splits']}, "
@@ -443,16 +452,51 @@ def _export_name(garment_mesh: Path) -> str:
     return name.lstrip(".") or "garment"
 
 
-def _check_output_folder(out: Path) -> None:
-    """Before any work: ``out`` can be created and written, and no other export holds
-    it (the export takes the same lock again while it writes)."""
+def _hold_output_folder(context: typer.Context, out: Path):
+    """Before any work: lock ``out`` for the rest of the command (released when it ends,
+    or by the kernel if it is killed). A second ``animate`` into the same folder is
+    refused at once, naming the holder, instead of both running and mixing their frames;
+    a folder that cannot be created or written is reported before the inference."""
     from gnngarment.geometry.files import FolderLock
+    from gnngarment.inference.output_folder import check_output_folder
 
     try:
-        with FolderLock(out, "export"):
-            pass
+        check_output_folder(out)  # says why (a file, a place that cannot be written)
+        return context.with_resource(FolderLock(out, "export"))
     except OSError as error:
         raise fail(f"--out {out}: {error}") from None
+
+
+def _check_animate_options(fps: float, duration: float, motion_up_axis: str,
+                           formats: list[str], fix_units: str, up_axis: str,
+                           scale: float | None, offset: tuple[float, float, float] | None,
+                           influences: int) -> None:
+    """``animate``'s options, before any loading: some are otherwise only read after the
+    animation (``--format``, ``--influences``) or once the body is built."""
+    import math
+
+    from gnngarment.inference.checks import UNIT_SCALES
+    from gnngarment.inference.export import FORMATS
+
+    for option, value in (("--fps", fps), ("--duration", duration)):
+        if not (value > 0 and math.isfinite(value)):  # also NaN
+            raise fail(f"{option} must be a finite number > 0, got {value}")
+    if motion_up_axis not in ("auto", "y", "z"):
+        raise fail(f"--motion-up-axis must be auto, y or z, got '{motion_up_axis}'")
+    unknown = [name for name in formats if name not in FORMATS]
+    if unknown or not formats:
+        raise fail(f"--format: unknown {unknown or 'empty list'}; choose from "
+                   f"{', '.join(FORMATS)}")
+    if fix_units not in ("auto", *UNIT_SCALES):
+        raise fail(f"--fix-units must be auto, {', '.join(UNIT_SCALES)}, got '{fix_units}'")
+    if up_axis not in ("z", "y", "auto"):
+        raise fail(f"--up-axis must be z, y or auto, got '{up_axis}'")
+    if scale is not None and not (scale > 0 and math.isfinite(scale)):
+        raise fail(f"--scale must be a finite number > 0, got {scale}")
+    if offset is not None and not all(math.isfinite(value) for value in offset):
+        raise fail(f"--offset must be 3 finite numbers (metres), got {list(offset)}")
+    if not 1 <= influences <= 8:  # the range of the glb writer's static skin
+        raise fail(f"--influences must be in 1..8, got {influences}")
 
 
 def _drape(placed, faces, body_inputs, garment_mesh: Path):
@@ -480,6 +524,7 @@ def _drape(placed, faces, body_inputs, garment_mesh: Path):
 
 @app.command()
 def animate(
+    context: typer.Context,
     garment_mesh: Annotated[Path, typer.Argument(help="Garment in the rest body's frame.")],
     out: Annotated[Path, typer.Option(help="Output folder.")] = Path("animated"),
     checkpoint: Annotated[Path | None, typer.Option(
@@ -532,8 +577,9 @@ def animate(
     from gnngarment.paths import SHIPPED_MODEL
     from gnngarment.training.checkpoint import load_model
 
-    if not (fps > 0 and fps != float("inf")):  # also NaN; checked before any loading
-        raise fail(f"--fps must be a finite number > 0, got {fps}")
+    format_list = [f.strip() for f in formats.split(",")]
+    _check_animate_options(fps, duration, motion_up_axis, format_list, fix_units, up_axis,
+                           scale, offset, influences)
     checkpoint = checkpoint or SHIPPED_MODEL
     try:
         model = load_model(checkpoint)
@@ -543,8 +589,6 @@ def animate(
         raise fail(str(error)) from None
     body_model, shape, motion_value = _load_body_and_motion(body_shape, motion, fps, duration,
                                                             joint_map, motion_up_axis)
-    # Inputs are read and valid; the output folder is checked before the long work.
-    _check_output_folder(out)
     body_inputs = body_shape_inputs(body_model, shape, model.config.body_vertices)
     try:
         placed = place_garment(pos, faces, body_inputs, units=fix_units, up_axis=up_axis,
@@ -552,6 +596,9 @@ def animate(
                                source_body=source)
     except ValueError as error:
         raise fail(f"{source_body or garment_mesh}: {error}") from None
+    # The output folder is taken before the long work: the drape, else the inference (a
+    # garment refused by the placement check then leaves no folder or lock file behind).
+    lock = _hold_output_folder(context, out) if drape else None
     if drape:
         placed = _drape(placed, faces, body_inputs, garment_mesh)
     pos = placed.pos
@@ -565,6 +612,8 @@ def animate(
         raise fail(f"{garment_mesh}: the garment is not on the rest body (see above; fix it "
                    "or pass --source-body, --fix-units/--scale, --up-axis, --offset, or "
                    "--ignore-placement)")
+    if lock is None:
+        lock = _hold_output_folder(context, out)
     frames = body_motion_inputs(body_model, shape, motion_value, model.config.body_vertices)
     bar = tqdm(total=len(motion_value), desc="animating", unit="frame")
 
@@ -594,8 +643,8 @@ def animate(
     try:
         paths = export_animation(
             animation, out, _export_name(garment_mesh),
-            formats=[f.strip() for f in formats.split(",")], include_body=body,
-            max_influences=influences, progress=exported)
+            formats=format_list, include_body=body,
+            max_influences=influences, progress=exported, lock=lock)
     except (ValueError, OSError) as error:
         raise fail(str(error)) from None
     for stage_bar in stages.values():
@@ -633,6 +682,7 @@ def benchmark_accuracy(
     unknown = [v for v in variant or [] if v not in VARIANTS]
     if unknown:
         raise fail(f"unknown variant(s) {unknown}; choose from {list(VARIANTS)}")
+    _check_output_file("--output", output)  # written only after every variant is trained
     try:
         settings = load_training_config(config)
     except (ConfigError, ValueError) as error:

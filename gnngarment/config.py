@@ -81,11 +81,15 @@ def merge_config(schema: type[T], values: Any, source: str = "<overrides>") -> T
     Raises:
         ConfigError: unknown key or wrong value type, naming ``source``.
     """
-    from omegaconf import OmegaConf
+    from omegaconf import DictConfig, OmegaConf
     from omegaconf.errors import OmegaConfBaseException
 
     if not dataclasses.is_dataclass(schema):
         raise TypeError(f"{schema!r} is not a dataclass")
+    if values is not None and not isinstance(values, (dict, DictConfig)):
+        # A YAML list or scalar: OmegaConf would raise a bare TypeError naming no file.
+        raise ConfigError(f"{source}: expected a mapping of settings, got a "
+                          f"{type(values).__name__.removesuffix('Config').lower()}")
     base = OmegaConf.structured(schema)
     OmegaConf.set_struct(base, True)  # unknown keys are errors (HOOD turns this off; we don't)
     try:

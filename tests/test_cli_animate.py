@@ -268,3 +268,61 @@ def test_inspect_and_attribute_take_the_source_body(files, anny_body, tmp_path) 
                                "--n-steps", "2", "--duration", "0.2"])
     assert heat.exit_code == 0, heat.output
     assert "fitted from the source body" in " ".join(heat.output.split())
+
+
+def _tree(folder: Path) -> dict[str, tuple[int, int]]:
+    """Every file under ``folder``: relative name → (size, mtime in ns)."""
+    return {str(p.relative_to(folder)): (p.stat().st_size, p.stat().st_mtime_ns)
+            for p in folder.rglob("*") if p.is_file()}
+
+
+@pytest.mark.slow
+def test_a_second_run_into_a_busy_folder_is_refused_and_a_killed_one_leaves_nothing(
+        files) -> None:
+    """While one ``animate`` runs (from its first step, not only while it writes), a
+    second into the same ``--out`` exits 2 naming the holder and touches nothing; the
+    first is then killed with SIGKILL mid-export, and the next, shorter run leaves no
+    temporary file and exactly its own frames (the manifest's count), none of the killed
+    run's."""
+    import json
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from gnngarment.geometry.files import TEMP_SUFFIX
+    from gnngarment.paths import REPOSITORY_ROOT
+
+    out = files["folder"] / "busy"
+    arguments = [str(files["garment"]), "--checkpoint", str(files["checkpoint"]), "--out",
+                 str(out), "--format", "obj,pc2", "--no-resolve-collisions"]
+    first = subprocess.Popen([sys.executable, "-m", "gnngarment.cli", "animate", *arguments,
+                              "--duration", "20"], cwd=REPOSITORY_ROOT,
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 300
+        lock = out / ".lock"
+        while not (lock.is_file() and lock.read_text() == f"pid {first.pid}"):
+            assert first.poll() is None and time.monotonic() < deadline
+            time.sleep(0.02)
+        before = _tree(out)
+        second = runner.invoke(app, ["animate", *arguments, "--duration", "0.2"])
+        assert second.exit_code == 2, second.output
+        assert f"another export (pid {first.pid})" in " ".join(second.output.split())
+        assert _tree(out) == before
+        frames = out / "skirt_obj"
+        while len(list(frames.glob("garment_*.obj"))) < 20:  # more than the next run's
+            assert first.poll() is None and time.monotonic() < deadline
+            time.sleep(0.005)
+    finally:
+        first.send_signal(signal.SIGKILL)
+        first.wait()
+    assert first.returncode == -signal.SIGKILL
+    again = runner.invoke(app, ["animate", *arguments, "--duration", "0.2"])
+    assert again.exit_code == 0, again.output
+    assert not list(out.rglob(f"*{TEMP_SUFFIX}"))
+    manifest = json.loads((out / "skirt_export.json").read_text())
+    written = sorted(p.name for p in frames.glob("garment_*.obj"))
+    assert len(written) == manifest["frames"] == 7, written[:3]
+    assert os.path.getsize(out / "skirt.pc2") > 0

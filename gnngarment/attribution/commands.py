@@ -122,8 +122,10 @@ def run_attribution(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,
 
 def _fail(message: str) -> None:
     from rich.console import Console
+    from rich.markup import escape
 
-    Console(stderr=True).print(f"[bold red]error:[/] {message}", highlight=False,
+    # Escaped: rich would drop a "[word]" in a message as a markup tag.
+    Console(stderr=True).print(f"[bold red]error:[/] {escape(message)}", highlight=False,
                                soft_wrap=True)
     raise typer.Exit(2)
 
@@ -194,8 +196,23 @@ def attribute_command(
         _fail(f"--output must be one of {', '.join(OUTPUTS)}, got '{output}'")
     if n_steps < 1:
         _fail(f"--n-steps must be >= 1, got {n_steps}")
+    if heat not in HEAT_CHANNELS:  # else said only after the body and motion are built
+        _fail(f"--heat must be one of {', '.join(HEAT_CHANNELS)}, got '{heat}'")
+    if scale not in SCALES:
+        _fail(f"--scale must be one of {', '.join(SCALES)}, got '{scale}'")
     if body_model not in ("anny", "smpl"):
         _fail(f"--body-model must be 'anny' or 'smpl', got '{body_model}'")
+    for option, value in (("--fps", fps), ("--duration", duration)):
+        if not (value > 0 and np.isfinite(value)):  # also NaN
+            _fail(f"{option} must be a finite number > 0, got {value}")
+    if motion_up_axis not in ("auto", "y", "z"):
+        _fail(f"--motion-up-axis must be auto, y or z, got '{motion_up_axis}'")
+    from gnngarment.inference.output_folder import check_output_folder
+
+    try:  # now, not when the results are written after the integrated gradients
+        check_output_folder(out)
+    except OSError as error:
+        _fail(f"--out {out}: {error}")
     try:
         model = load_model(checkpoint)
         pos, faces = load_mesh(garment_mesh)

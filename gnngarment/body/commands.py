@@ -12,8 +12,12 @@ import typer
 
 def _fail(message: str) -> None:
     from rich.console import Console
+    from rich.markup import escape
 
-    Console(stderr=True).print(f"[bold red]error:[/] {message}", highlight=False)
+    # soft_wrap: one line however long (rich would break it at the terminal width);
+    # escaped: rich would drop a "[word]" in a message as a markup tag.
+    Console(stderr=True).print(f"[bold red]error:[/] {escape(message)}", highlight=False,
+                               soft_wrap=True)
     raise typer.Exit(2)
 
 
@@ -102,10 +106,11 @@ def body_command(
 
     console = Console(stderr=True)
     start = time.perf_counter()
-    if fps <= 0:
-        _fail(f"--fps must be > 0, got {fps}")
-    if duration <= 0:
-        _fail(f"--duration must be > 0, got {duration}")
+    for option, value in (("--fps", fps), ("--duration", duration)):
+        if not (value > 0 and np.isfinite(value)):  # also NaN, which `<= 0` lets through
+            _fail(f"{option} must be a finite number > 0, got {value}")
+    if motion_up_axis not in ("auto", "y", "z"):
+        _fail(f"--motion-up-axis must be auto, y or z, got '{motion_up_axis}'")
     if model not in ("anny", "smpl"):
         _fail(f"--model must be 'anny' or 'smpl', got '{model}'")
     try:
@@ -117,9 +122,12 @@ def body_command(
     try:
         with console.status(f"loading the {model} body model (first Anny run builds a cache)"):
             body = create_body_model(BodyConfig(model=model, smpl_model_path=smpl_path))
-        body_shape = body.parse_shape(shape)
     except (SMPLModelError, ValueError) as error:
         _fail(str(error))
+    try:
+        body_shape = body.parse_shape(shape)
+    except (ValueError, OSError) as error:
+        _fail(f"--shape {shape}: {error}")
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as error:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import hashlib
 import random
+import re
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -54,8 +55,8 @@ def content_hash(payload: dict[str, Any]) -> str:
 
 def runtime_environment() -> dict[str, Any]:
     """What a run's numbers depend on besides its config and seed: torch's thread
-    counts and the versions of python, torch, numpy, torch_geometric and gnngarment
-    (``None`` for a package that is not installed)."""
+    counts, whether its deterministic algorithms were on, and the versions of python,
+    torch, numpy, torch_geometric and gnngarment (``None`` for one not installed)."""
     import platform
     from importlib.metadata import PackageNotFoundError, version
 
@@ -67,6 +68,7 @@ def runtime_environment() -> dict[str, Any]:
 
     return {"torch_threads": torch.get_num_threads(),
             "torch_interop_threads": torch.get_num_interop_threads(),
+            "deterministic": torch.are_deterministic_algorithms_enabled(),
             "python": platform.python_version(), "torch": str(torch.__version__),
             "numpy": str(np.__version__), "torch_geometric": installed("torch_geometric"),
             "gnngarment": installed("gnngarment")}
@@ -108,8 +110,9 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
             lines = [line for line in lines if not line.startswith("Check the documentation")]
             gist = lines[-1].removeprefix("WeightsUnpickler error:").strip().split(". ")[0]
             detail = f"refused by weights-only loading: {gist}"
-        else:
-            detail = lines[0] if lines else type(error).__name__
+        else:  # its first sentence: torch adds a paragraph of advice to a truncated zip's
+            detail = (re.split(r"(?<=\.)\s+(?=[A-Z])", lines[0])[0].rstrip(".") if lines
+                      else type(error).__name__)
         raise ValueError(f"{path}: not a readable gnngarment checkpoint ({detail})") from error
     if not isinstance(payload, dict) or payload.get("format_version") != CHECKPOINT_FORMAT_VERSION:
         raise ValueError(f"{path}: not a gnngarment checkpoint (format "
@@ -150,6 +153,10 @@ def load_model(path: str | Path) -> GarmentDeformer:
         ValueError: unreadable, or its weights do not fit its model config (names it).
     """
     payload = load_checkpoint(path)
+    # A training-state file or a foreign torch file of the same format: no model in it.
+    missing = [key for key in ("model_config", "model_state") if key not in payload]
+    if missing:
+        raise ValueError(f"{path}: not a model checkpoint (no {' or '.join(missing)})")
     config = stored_model_config(payload["model_config"], source=str(path))
     model = GarmentDeformer(config)
     try:

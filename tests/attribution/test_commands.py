@@ -108,7 +108,7 @@ def test_a_garment_off_the_body_is_refused_before_attribution(tmp_path) -> None:
 
     pos, faces = tube(12, 16)
     far = tmp_path / "far.obj"
-    trimesh.Trimesh(pos + [3.0, 0.0, 1.0], faces, process=False).export(far)
+    trimesh.Trimesh(pos + np.array([3.0, 0.0, 1.0]), faces, process=False).export(far)
     out = tmp_path / "out"
     result = CliRunner().invoke(app, ["attribute", str(SHIPPED_MODEL), str(far), "--out",
                                       str(out), "--n-steps", "2", "--duration", "0.2"])

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable
+from contextlib import nullcontext
 from numbers import Integral
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -49,7 +50,8 @@ def export_animation(animation: Animation, out_dir: str | Path, name: str,
                      include_body: bool = True, progress: Progress | None = None, *,
                      first_frame: int = 0, max_influences: int = 4,
                      morph_interpolation: str = "LINEAR", preview_size: int = 288,
-                     preview_max_frames: int = 48) -> dict[str, Path]:
+                     preview_max_frames: int = 48,
+                     lock: FolderLock | None = None) -> dict[str, Path]:
     """Export an animation in the requested formats.
 
     Args:
@@ -68,6 +70,8 @@ def export_animation(animation: Animation, out_dir: str | Path, name: str,
         morph_interpolation: glb morph weights, ``"LINEAR"`` or ``"STEP"``.
         preview_size: preview height/width in pixels.
         preview_max_frames: the preview renders every k-th frame to stay under this.
+        lock: the caller's held lock on ``out_dir`` (a command that took it before its
+            inference); ``None``: the export takes one while it writes.
 
     Returns:
         Paths by key: ``"glb"``, ``"pc2"``, ``"rest_obj"``, ``"body_pc2"``, ``"body_obj"``,
@@ -88,9 +92,17 @@ def export_animation(animation: Animation, out_dir: str | Path, name: str,
     out = Path(out_dir)
     # One export per folder at a time (a second is refused, naming the holder), and the
     # temporary files a killed earlier export left behind are removed first.
-    with FolderLock(out, "export") as lock:
+    if lock is not None and lock.folder.resolve() != out.resolve():
+        raise ValueError(f"the lock given is on {lock.folder}, not on {out}")
+    with nullcontext(lock) if lock is not None else FolderLock(out, "export") as lock:
         lock.remove_stale_temporaries((".", f"{name}_obj"))
         previous = _previous_frames(out / f"{name}_export.json")
+        if "obj" in formats:
+            # Until this export ends, its manifest says which frames may be on disk (the
+            # previous export's and this one's): an export killed part-way leaves frames
+            # the next one then knows to remove.
+            _write_pending_manifest(out / f"{name}_export.json", name, previous,
+                                    first_frame, len(animation.posed))
         paths = _export(animation, out, name, formats, include_body, progress, first_frame,
                         max_influences, morph_interpolation, preview_size, preview_max_frames)
         if "obj" in formats and previous is not None:
@@ -108,18 +120,32 @@ def _previous_frames(manifest: Path) -> tuple[int, int] | None:
         return None
 
 
+def _write_pending_manifest(manifest: Path, name: str, previous: tuple[int, int] | None,
+                            first_frame: int, frames: int) -> None:
+    """The manifest of an export in progress: the frame range covering the previous
+    export's frames and this one's (replaced by the full manifest at the end)."""
+    start, end = first_frame, first_frame + frames
+    if previous is not None:
+        start, end = min(start, previous[0]), max(end, previous[0] + previous[1])
+    atomic_write_bytes(manifest, json.dumps({
+        "name": name, "first_frame": start, "frames": end - start, "in_progress": True,
+    }, indent=2).encode())
+
+
 def _remove_stale_frames(folder: Path, previous: tuple[int, int], first_frame: int,
                          frames: int) -> None:
     """Delete the per-frame OBJs a previous export (per its manifest) wrote that this one
     did not overwrite — a shorter re-run would otherwise leave its old extra frames."""
     start, count = previous
-    digits = max(4, len(str(start + count - 1)))
     kept = range(first_frame, first_frame + frames)
+    # Frame numbers are zero-padded to the widest number of the export that wrote them.
+    widths = {4, len(str(start + count - 1))}
     for frame in range(start, start + count):
         if frame in kept:
             continue
         for stem in ("garment", "body"):
-            frame_path(folder, stem, frame, digits).unlink(missing_ok=True)
+            for digits in widths:
+                frame_path(folder, stem, frame, digits).unlink(missing_ok=True)
 
 
 def _export(animation: Animation, out: Path, name: str, formats, include_body: bool,

@@ -1,0 +1,37 @@
+"""Is an output folder usable? Checked before a long run, leaving nothing behind."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+from gnngarment.geometry.files import FolderLock
+
+
+def check_output_folder(out: str | Path, what: str = "export") -> None:
+    """Before any work: ``out`` is a folder or can be made one, files can be written in
+    it, and no other ``what`` holds its :class:`FolderLock`.
+
+    Creates nothing and leaves nothing behind (a refused run must not leave an empty
+    folder or a lock file): the run makes the folder when it writes.
+
+    Raises:
+        OSError: why not (:class:`~gnngarment.geometry.files.FolderBusyError` when
+            another run holds the folder).
+    """
+    out = Path(out)
+    existing = out
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent  # the folder that the run's mkdir would start from
+    if not existing.is_dir():
+        raise NotADirectoryError(f"{existing} is a file, not a folder")
+    # A probe folder made and removed at once: os.access says yes to root on /proc.
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".probe-", dir=existing))
+    except OSError as error:
+        raise PermissionError(f"cannot write in {existing} ({error.strerror})") from None
+    if existing == out and (out / ".lock").is_file():
+        # Only a folder with a lock file can be held; taking it rewrites only that file.
+        with FolderLock(out, what):
+            pass
