@@ -104,9 +104,25 @@ def garment_pair(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,
         body_distances=torch.from_numpy(body.distances), body_weights=body_weights)
 
 
+#: Garment vertices × frames per forward pass (16 frames of a 5,000-vertex garment).
+#: Measured with the shipped model (docs/reliability.md, "Memory"): a pass takes
+#: ~6.8 kB per vertex-frame at its peak, and per frame it gets *slower* beyond this
+#: (a 78k-vertex garment: 1.2 s for 1 frame, 8.8 s for 4), so a large garment runs
+#: one frame at a time in bounded memory.
+MAX_VERTEX_FRAMES = 80_000
+#: The most frames per pass (small garments gain nothing beyond it).
+MAX_FRAMES_PER_CHUNK = 16
+
+
+def frames_per_chunk(vertices: int) -> int:
+    """Frames per forward pass for a garment of ``vertices`` vertices: as many as
+    :data:`MAX_VERTEX_FRAMES` allows, at least 1, at most :data:`MAX_FRAMES_PER_CHUNK`."""
+    return max(1, min(MAX_FRAMES_PER_CHUNK, MAX_VERTEX_FRAMES // max(vertices, 1)))
+
+
 @torch.inference_mode()
 def animate(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray, body: BodyShapeInputs,
-            frames: BodyMotionInputs, chunk: int = 16, source: str = "<garment>",
+            frames: BodyMotionInputs, chunk: int | None = None, source: str = "<garment>",
             progress: Callable[[int, int], None] | None = None,
             resolve_collisions: bool = True,
             collisions: CollisionSettings | None = None) -> Animation:
@@ -124,7 +140,8 @@ def animate(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray, body: Bo
             Z up) and ``(F, 3)`` triangles.
         body: body-shape inputs (:func:`body_shape_inputs`).
         frames: the posed body's per-frame inputs (:func:`body_motion_inputs`).
-        chunk: frames per forward pass.
+        chunk: frames per forward pass; ``None``: :func:`frames_per_chunk` (memory and
+            time per frame grow with the chunk's vertex-frames, not only its frames).
         progress: called with (frames done, total) after each chunk.
         resolve_collisions: remove body penetrations (rest garment and every frame).
         collisions: ``ε`` and smoothing; default :class:`CollisionSettings`.
@@ -157,6 +174,7 @@ def animate(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray, body: Bo
 
     window = model.config.window
     total = frames.motion_features.shape[0]
+    chunk = chunk or frames_per_chunk(len(pos))
     motion = torch.from_numpy(frames.motion_features)
     velocity = torch.from_numpy(frames.velocities.reshape(total, -1))
     transforms = torch.from_numpy(frames.joint_transforms)

@@ -98,3 +98,18 @@ def test_triangle_soup_is_animated_as_the_welded_mesh(scene) -> None:
     np.testing.assert_array_equal(soup.faces, soup_faces)
     np.testing.assert_allclose(soup.posed, welded.posed[:, faces.reshape(-1)], atol=1e-6)
     np.testing.assert_allclose(soup.weights, welded.weights[:, faces.reshape(-1)], atol=1e-6)
+
+
+def test_frames_in_chunks_of_any_size_give_the_same_animation(scene) -> None:
+    """A large garment runs fewer frames per pass (bounded memory): the frames are
+    independent given the context, so the chunking changes nothing beyond float noise."""
+    from gnngarment.inference.animate import MAX_FRAMES_PER_CHUNK, frames_per_chunk
+
+    whole = animate(scene["model"], scene["pos"], scene["faces"], scene["body"],
+                    scene["frames"], resolve_collisions=False, chunk=FRAMES)
+    single = animate(scene["model"], scene["pos"], scene["faces"], scene["body"],
+                     scene["frames"], resolve_collisions=False, chunk=1)
+    np.testing.assert_allclose(single.posed, whole.posed, atol=1e-6)
+    np.testing.assert_allclose(single.weights, whole.weights, atol=1e-6)
+    assert frames_per_chunk(5_000) == MAX_FRAMES_PER_CHUNK == frames_per_chunk(10)
+    assert frames_per_chunk(20_000) == 4 and frames_per_chunk(300_000) == 1
