@@ -19,7 +19,8 @@ implementations (``csr``: GraphAttention, ``pyg``: GATConv), with:
   model ÷ simulator ratio.
 
     .venv/bin/python benchmarks/inference_speed.py [--vertices 5000] [--configs small paper]
-        [--batches 1 16] [--attention csr pyg] [--malloc both] [--repeats 5] [--threads 1 2]
+        [--batches 1 16] [--attention csr pyg] [--malloc both] [--repeats 5]
+        [--threads 1 2 auto]
         [--no-bf16] [--no-simulator] [--sim-frames 30]
 
 Timings are the best of ``--repeats`` runs after a warm-up run (the warm-up builds the
@@ -250,8 +251,13 @@ def initial_model(config: ModelConfig, args: argparse.Namespace
 def child(args: argparse.Namespace) -> None:
     """Measure one config at one thread count, every implementation in ``--impl``
     interleaved; print one JSON line per implementation."""
-    threads = args.threads[0]
-    torch.set_num_threads(threads)
+    if args.threads[0] == "auto":  # what the CLI does: the cores idle right now
+        from gnngarment.threads import use_idle_cores
+
+        threads = f"auto={use_idle_cores()}"
+    else:
+        threads = int(args.threads[0])
+        torch.set_num_threads(threads)
     config = load_config(ROOT / "configs" / "model" / f"{args.config}.yaml", ModelConfig)
     pos, faces = flared_skirt(args.vertices)
     pair = make_pair(pos, faces, config)
@@ -433,8 +439,10 @@ def main() -> None:
     parser.add_argument("--attention", nargs="+", default=["csr", "pyg"],
                         choices=["csr", "pyg"])
     parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--threads", type=int, nargs="+", default=[1, 2],
-                        help="intra-op threads (each value measured separately)")
+    parser.add_argument("--threads", nargs="+", default=["1", "2", "auto"],
+                        choices=["1", "2", "3", "4", "8", "16", "auto"],
+                        help="intra-op threads (each value measured separately); auto: "
+                             "the idle cores at start, as the CLI chooses them")
     parser.add_argument("--checkpoint", default=str(ROOT / "models" / "gnngarment-small.pt"),
                         help="trained weights, used for the config whose network they fit "
                              "('' for random init everywhere)")
@@ -473,6 +481,8 @@ def main() -> None:
         if not args.bf16 or malloc != variants[0]:
             command.append("--no-bf16")
         env = dict(os.environ, **(MALLOC_TUNED if malloc == "tuned" else {}))
+        if threads == "auto":  # the choice is the child's, not a variable's
+            env.pop("OMP_NUM_THREADS", None)
         tic = time.perf_counter()
         done = subprocess.run(command, capture_output=True, text=True, env=env, check=False)
         lines = [ln for ln in done.stdout.splitlines() if ln.startswith("RESULT ")]

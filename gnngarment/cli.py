@@ -15,6 +15,8 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from gnngarment.threads import use_idle_cores
+
 app = typer.Typer(help="Animate any garment mesh with one learned model.",
                   no_args_is_help=True, add_completion=False)
 console = Console()
@@ -372,6 +374,7 @@ def evaluate(
 
     for option, path in (("--json", json_path), ("--markdown", markdown)):
         _check_output_file(option, path)
+    use_idle_cores()
     try:
         model = load_model(checkpoint)
         if data is None:
@@ -581,6 +584,7 @@ def animate(
     _check_animate_options(fps, duration, motion_up_axis, format_list, fix_units, up_axis,
                            scale, offset, influences)
     checkpoint = checkpoint or SHIPPED_MODEL
+    use_idle_cores()
     try:
         model = load_model(checkpoint)
         pos, faces, uv, uv_faces = load_textured_mesh(garment_mesh)

@@ -213,6 +213,9 @@ def attribute_command(
         check_output_folder(out)
     except OSError as error:
         _fail(f"--out {out}: {error}")
+    from gnngarment.threads import use_idle_cores
+
+    use_idle_cores()
     try:
         model = load_model(checkpoint)
         pos, faces = load_mesh(garment_mesh)

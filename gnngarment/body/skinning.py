@@ -64,8 +64,7 @@ def skin(
             )
         if joint_transforms.dim() != 4:
             raise ValueError("with a batch vector, joint_transforms must be (B, 24, 4, 4)")
-        # Blend the transforms per vertex: (N, 3, 4).
-        blended = torch.einsum("nj,njab->nab", weights, affine[batch])
+        blended = _blend_ragged(weights, affine.reshape(-1, NUM_JOINTS, 12), batch)
     else:
         if weights.shape[:-1] != rest_vertices.shape[:-1] and weights.dim() == rest_vertices.dim():
             raise ValueError(
@@ -76,4 +75,22 @@ def skin(
         flat = affine.reshape(*affine.shape[:-3], NUM_JOINTS, 12)
         product = torch.matmul(weights, flat)  # (..., N, 12), broadcast over leading dims
         blended = product.reshape(*product.shape[:-1], 3, 4)
-    return (blended[..., :3] @ points[..., None])[..., 0] + blended[..., 3]
+    # x = A p + t per vertex, elementwise: a batched matmul of 3x3 blocks is ~10x slower.
+    return (blended[..., :3] * points[..., None, :]).sum(-1) + blended[..., 3]
+
+
+def _blend_ragged(weights: torch.Tensor, flat: torch.Tensor, batch: torch.Tensor
+                  ) -> torch.Tensor:
+    """Per-vertex blended transforms ``(N, 3, 4)`` of the ragged layout: ``weights
+    (N, 24)`` against ``flat (B, 24, 12)``, vertex ``i`` using item ``batch[i]``.
+
+    With the items' vertices in contiguous runs (PyG's batch layout, and every batch the
+    model builds) each item is one ``(n_b, 24) @ (24, 12)`` product. Gathering the
+    transforms per vertex instead materialises ``N × 24 × 12`` floats (92 MB for 16 frames
+    of a 5,000-vertex garment) and took 14 % of the forward pass.
+    """
+    if len(batch) > 1 and bool((batch[1:] < batch[:-1]).any()):  # not in runs: gather
+        return torch.einsum("nj,njk->nk", weights, flat[batch]).view(-1, 3, 4)
+    counts = torch.bincount(batch, minlength=flat.shape[0]).tolist()
+    parts = [part @ flat[item] for item, part in enumerate(torch.split(weights, counts))]
+    return torch.cat(parts).view(-1, 3, 4)

@@ -78,7 +78,8 @@ class TrainingConfig:
             (the blueprint's batch of 64 = e.g. 4 × 16).
         learning_rate: Adamax learning rate, decayed by a cosine over ``epochs``.
         collision_margin: ε of the collision term (metres).
-        threads: torch intra-op threads (0 = torch's default).
+        threads: torch intra-op threads (0 = the cores idle when training starts,
+            :func:`gnngarment.threads.choose_threads`).
         validate_every: epochs between validation passes.
         deterministic: torch's deterministic algorithms (its scatter/index-add
             reductions otherwise sum in a thread-dependent order): two runs of one

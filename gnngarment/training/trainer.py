@@ -88,6 +88,10 @@ class Trainer:
         self.output = Path(config.output)
         if config.threads:
             torch.set_num_threads(config.threads)
+        else:
+            from gnngarment.threads import use_idle_cores
+
+            use_idle_cores()
         # Process-wide, as torch has it; a trainer sets it either way, so one run's
         # choice does not leak into the next in the same process.
         torch.use_deterministic_algorithms(config.deterministic)

@@ -58,6 +58,15 @@ def test_ragged_batch_matches_dense():
         dense = skin(rest[i][None], None, weights[i][None], transforms[i : i + 1])[0]
         assert torch.allclose(out[batch == i], dense)
     assert out.shape == (sum(sizes), 3)
+    # Items interleaved rather than in runs (and an item with no vertex): the same.
+    order = torch.randperm(len(batch))
+    with_empty = torch.cat([transforms[:1], _random_transforms(1), transforms[1:]])
+    shuffled = skin(torch.cat(rest)[order], None, torch.cat(weights)[order], with_empty,
+                    batch=torch.where(batch == 1, 2, batch)[order])
+    assert torch.allclose(shuffled, out[order])
+    gapped = skin(torch.cat(rest), None, torch.cat(weights), with_empty,
+                  batch=torch.where(batch == 1, 2, batch))
+    assert torch.allclose(gapped, out)
 
 
 def test_gradcheck():
