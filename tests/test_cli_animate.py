@@ -196,17 +196,19 @@ def test_source_body_with_explicit_placement_or_a_bad_file_exits_2(files, tmp_pa
 
 def test_drape_settles_the_garment_before_animating(files) -> None:
     """`--drape`: the rest garment written is the settled one (it moved, downwards on
-    average: gravity), and the command says how it went."""
+    average: gravity), hanging from its waistband rather than sliding off the hips to
+    the floor (it fell ~1 m before the band was held), and the command says how it
+    went."""
     out = files["folder"] / "draped"
     result = runner.invoke(app, ["animate", str(files["garment"]), "--drape", "--checkpoint",
                                  str(files["checkpoint"]), "--out", str(out), "--duration",
                                  "0.1", "--format", "pc2", "--no-body"])
     assert result.exit_code == 0, result.output
     text = " ".join(result.output.split())
-    assert "draped on the rest body" in text
+    assert "draped on the rest body" in text and "hanging from its top band" in text
     given, _ = load_mesh(files["garment"])
     draped, _ = load_mesh(out / "skirt_rest.obj")
-    assert np.linalg.norm(draped - given, axis=1).mean() > 0.002
+    assert 0.002 < np.linalg.norm(draped - given, axis=1).mean() < 0.15  # the flare sags
     assert (draped[:, 2] - given[:, 2]).mean() < 0
 
 

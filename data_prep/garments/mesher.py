@@ -34,6 +34,7 @@ from data_prep.garments.pattern import (
     triangulate,
 )
 from data_prep.garments.shapes import Design, gradient
+from gnngarment.geometry.boundary import boundary_loops as geometry_boundary_loops
 
 MAX_STEP = 0.02  # metres: largest Newton step onto the surface (no jumps across gaps)
 
@@ -63,27 +64,15 @@ def adjacency(faces: np.ndarray, n: int) -> sp.csr_matrix:
 
 
 def boundary_loops(faces: np.ndarray) -> list[np.ndarray]:
-    """Boundary loops of a manifold triangle mesh, each ``(L,)`` vertex indices in order
-    (following the faces' winding)."""
-    directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    n = int(faces.max()) + 1
-    keys = directed[:, 0] * n + directed[:, 1]
-    reverse = directed[:, 1] * n + directed[:, 0]
-    border = directed[~np.isin(keys, reverse)]
-    following = dict(zip(border[:, 0].tolist(), border[:, 1].tolist(), strict=True))
-    if len(following) != len(border):
-        raise PatternError("a boundary vertex is on two boundary loops (non-manifold vertex)")
-    loops, seen = [], set()
-    for start in border[:, 0].tolist():
-        if start in seen:
-            continue
-        loop, v = [], start
-        while v not in seen:
-            seen.add(v)
-            loop.append(v)
-            v = following[v]
-        loops.append(np.array(loop, dtype=np.int64))
-    return loops
+    """:func:`gnngarment.geometry.boundary.boundary_loops`, failing as a pattern does.
+
+    Raises:
+        PatternError: a boundary vertex is on two loops (the sampler retries).
+    """
+    try:
+        return geometry_boundary_loops(faces)
+    except ValueError as error:
+        raise PatternError(str(error)) from None
 
 
 GRID_DENSE = 0.002  # metres: pattern spacing at which seam/opening lengths are measured

@@ -35,6 +35,12 @@ FLOATING_DISTANCE = 0.3
 #: Median distance (metres) from the body beyond which a garment as given is "far off"
 #: for the up-axis rule (Z-up garments on their own body measured at most 9 cm).
 FAR_AS_GIVEN = 0.12
+#: How far (metres) a garment may reach above the top of the head (a hood, a hat's
+#: brim) and below the soles; and the share of its vertices beyond that which marks it
+#: as placed in another frame (CLOTH3D's starter kit: trousers in a world frame, feet
+#: at z = 0, land around the head with the body's median distance of a loose garment).
+BEYOND_HEIGHT = (0.10, 0.05)
+BEYOND_FRACTION = 0.05
 #: Depth (metres) below the body surface that counts as inside.
 INSIDE_DEPTH = 0.005
 #: Share of garment vertices inside the body that is reported (warning, error).
@@ -185,6 +191,20 @@ def check_garment_placement(pos: np.ndarray, faces: np.ndarray, body_vertices: n
             f"({offset[0]:+.2f}, {offset[1]:+.2f}, {offset[2]:+.2f}) m: move it onto the "
             f"rest body in its T-pose (--offset X Y Z, or --source-body with the body it "
             f"was made on)", {}))
+        return findings
+    body_bottom, body_top = body[:, 2].min(), body[:, 2].max()
+    above = placed[:, 2] > body_top + BEYOND_HEIGHT[0]
+    below = placed[:, 2] < body_bottom - BEYOND_HEIGHT[1]
+    if np.mean(above | below) > BEYOND_FRACTION:
+        where, reach = (("above the top of the body's head", placed[:, 2].max() - body_top)
+                        if above.sum() >= below.sum() else
+                        ("below the body's soles", body_bottom - placed[:, 2].min()))
+        findings.append(Finding(
+            "beyond_body", "error",
+            f"{100 * np.mean(above | below):.0f}% of the garment's vertices are {where} "
+            f"(by up to {reach:.2f} m){after}: it looks placed in another frame (e.g. a "
+            f"world frame with the feet at z = 0); move it onto the rest body in its "
+            f"T-pose (--offset X Y Z, or --source-body with the body it was made on)", {}))
         return findings
     distance = float(np.median(surface.distance(placed)))
     if distance > FLOATING_DISTANCE:

@@ -81,7 +81,8 @@ def drape_on_rest_body(placed: PlacedGarment, faces: np.ndarray, body: BodyShape
                        progress: Callable[[int, int], None] | None = None) -> PlacedGarment:
     """Settle the garment on the still rest body with the reference simulator (Newton
     VBD, the dataset builder's drape): what ``animate --drape`` does for a garment that
-    is not yet at rest.
+    is not yet at rest. The garment's highest boundary loop, when it goes around the
+    body (:func:`~gnngarment.geometry.boundary.support_band`), is held in place.
 
     Raises:
         ValueError: the simulator refused the input; SimulationFailed: every attempt
@@ -89,10 +90,16 @@ def drape_on_rest_body(placed: PlacedGarment, faces: np.ndarray, body: BodyShape
     """
     # Imported here: the simulator (warp, Newton) is heavy and only this step needs it.
     from data_prep.simulate import drape_garment
+    from gnngarment.geometry.boundary import support_band
 
+    # As the dataset builder pins a waist ring: a garment hangs from its top band.
+    band = support_band(placed.pos, faces, body.rest_vertices)
     result = drape_garment(placed.pos, faces, body.rest_vertices, body.faces,
-                           max_frames=max_frames, progress=progress)
+                           pinned=band if len(band) else None, max_frames=max_frames,
+                           progress=progress)
     state = "settled" if result.settled else f"stopped at the {max_frames}-frame cap"
+    if len(band):
+        state += f", hanging from its top band ({len(band)} vertices held)"
     return PlacedGarment(
         pos=result.positions.astype(np.float64), fitted=placed.fitted,
         seconds={**placed.seconds, "drape": result.seconds},

@@ -95,6 +95,21 @@ def test_far_from_the_body(body, garment) -> None:
     assert f"offset (x, y, z) = (+3.00, +0.00, {dz:+.2f}) m" in findings[0].message
 
 
+def test_above_the_head_or_below_the_soles(body, garment) -> None:
+    """A garment whose box still overlaps the body's but reaches well above the head (or
+    below the feet) was placed in another frame, however close to the body it is: the
+    CLOTH3D starter kit's world-frame trousers landed around the head."""
+    top = body[0][:, 2].max()
+    lifted = garment[0] + np.array([0.0, 0.0, top - garment[0][:, 2].min() - 0.2])
+    findings = check_garment_placement(lifted, garment[1], *body)
+    assert codes(findings) == [("beyond_body", "error")]
+    assert "above the top of the body's head" in findings[0].message
+    bottom = body[0][:, 2].min()
+    dropped = garment[0] + np.array([0.0, 0.0, bottom - garment[0][:, 2].max() + 0.1])
+    assert "below the body's soles" in check_garment_placement(dropped, garment[1],
+                                                               *body)[0].message
+
+
 def test_floating_away_from_the_body(body) -> None:
     wide, faces = tube(6, 24, radius=0.8, height=0.4)
     findings = check_garment_placement(wide + np.array([0.0, 0.0, 0.6]), faces, *body)
@@ -190,3 +205,22 @@ def test_up_axis_of_real_garments_made_on_other_bodies(anny_rest) -> None:
         pos = pos * UNIT_SCALES[detect_units(pos, body[0]) or "m"]
         found[path.stem] = detect_up_axis(pos, *body)
     assert found == {name: "y" if name in Y_UP_GARMENTS else "z" for name in found}, found
+
+
+@pytest.mark.skipif(not REAL_GARMENTS.is_dir(), reason="../shared/real-world is absent "
+                    "(third-party test data beside the repository, not in a clone)")
+def test_world_frame_cloth3d_trousers_are_refused_and_the_others_are_not(anny_rest) -> None:
+    """The starter kit's trousers (world frame, feet at z = 0) are refused; none of the
+    real garments on their own is flagged as reaching beyond our body."""
+    from gnngarment.geometry.mesh_io import load_mesh
+    from gnngarment.inference.checks import fix_placement
+
+    body = anny_rest.vertices.numpy().astype(np.float64), anny_rest.faces
+    trousers, faces = load_mesh(REAL_GARMENTS.parent / "cloth3d" / "starterkit" / "Trousers.obj")
+    assert "beyond_body" in [f.code for f in check_garment_placement(trousers, faces, *body)]
+    for path in sorted(REAL_GARMENTS.glob("*.obj")):
+        pos, faces = load_mesh(path)
+        fixed, _ = fix_placement(pos, units="auto", up_axis="auto", body_vertices=body[0],
+                                 body_faces=body[1])
+        codes_found = [f.code for f in check_garment_placement(fixed, faces, *body)]
+        assert "beyond_body" not in codes_found, path.name
