@@ -68,7 +68,7 @@ def run(out: Path, data_config: Path, train_config: Path, model_path: Path | Non
     from data_prep.build import build_dataset
     from data_prep.config import DataConfig
     from data_prep.posed_bodies import synthetic_body_meshes, synthetic_skinning_weights
-    from gnngarment.attribution.commands import run_attribution
+    from gnngarment.attribution.heatmap_files import run_attribution
     from gnngarment.body import make_motion
     from gnngarment.config import load_config
     from gnngarment.data import PreparedDataset

@@ -15,31 +15,18 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from gnngarment.cli.errors import fail
 from gnngarment.threads import use_idle_cores
 
 app = typer.Typer(help="Animate any garment mesh with one learned model.",
                   no_args_is_help=True, add_completion=False)
 console = Console()
-errors = Console(stderr=True)
 
 
 
 @app.callback()
 def root() -> None:
     """Animate any garment mesh with one learned model."""
-
-
-#: Exit code for bad input (usage errors share it, as in typer/click).
-BAD_INPUT = 2
-
-
-def fail(message: str) -> typer.Exit:
-    """Print ``message`` as an error and return the exit to raise."""
-    from rich.markup import escape
-
-    # Escaped: rich would drop "[low, high]" or ".[ray]" in a message as a markup tag.
-    errors.print(f"[bold red]error:[/] {escape(message)}", highlight=False, soft_wrap=True)
-    return typer.Exit(BAD_INPUT)
 
 
 def _garment_config(config_path: Path | None, levels: int | None):
@@ -705,22 +692,18 @@ def benchmark_accuracy(
     console.print(f"[green]wrote[/] {output}: {len(result['rows'])} rows")
 
 
-def _register_subpackage_commands() -> None:
-    """``body``, ``motions`` and ``attribute`` live next to the code they drive."""
-    from gnngarment.attribution.commands import register as register_attribution
-    from gnngarment.body.commands import register as register_body
+def _register_commands() -> None:
+    from gnngarment.cli.attribute import register as register_attribution
+    from gnngarment.cli.body import register as register_body
 
     register_body(app)
     register_attribution(app)
 
 
-_register_subpackage_commands()
+_register_commands()
 
 
 def main() -> None:
     """Console-script entry point."""
     app()
 
-
-if __name__ == "__main__":
-    main()

@@ -1,7 +1,7 @@
 import typer
 from typer.testing import CliRunner
 
-from gnngarment.body.commands import register
+from gnngarment.cli.body import register
 
 
 def _app():

@@ -9,16 +9,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
-
-def _fail(message: str) -> None:
-    from rich.console import Console
-    from rich.markup import escape
-
-    # soft_wrap: one line however long (rich would break it at the terminal width);
-    # escaped: rich would drop a "[word]" in a message as a markup tag.
-    Console(stderr=True).print(f"[bold red]error:[/] {escape(message)}", highlight=False,
-                               soft_wrap=True)
-    raise typer.Exit(2)
+from gnngarment.cli.errors import fail
 
 
 def write_obj_sequence(
@@ -108,30 +99,30 @@ def body_command(
     start = time.perf_counter()
     for option, value in (("--fps", fps), ("--duration", duration)):
         if not (value > 0 and np.isfinite(value)):  # also NaN, which `<= 0` lets through
-            _fail(f"{option} must be a finite number > 0, got {value}")
+            raise fail(f"{option} must be a finite number > 0, got {value}")
     if motion_up_axis not in ("auto", "y", "z"):
-        _fail(f"--motion-up-axis must be auto, y or z, got '{motion_up_axis}'")
+        raise fail(f"--motion-up-axis must be auto, y or z, got '{motion_up_axis}'")
     if model not in ("anny", "smpl"):
-        _fail(f"--model must be 'anny' or 'smpl', got '{model}'")
+        raise fail(f"--model must be 'anny' or 'smpl', got '{model}'")
     try:
         motion_data = None if rest else load_motion(
             motion, fps=fps, joint_map=joint_map, up_axis=motion_up_axis,
             **({} if Path(motion).suffix else {"duration": duration, "seed": seed}))
     except MotionError as error:
-        _fail(str(error))
+        raise fail(str(error)) from None
     try:
         with console.status(f"loading the {model} body model (first Anny run builds a cache)"):
             body = create_body_model(BodyConfig(model=model, smpl_model_path=smpl_path))
     except (SMPLModelError, ValueError) as error:
-        _fail(str(error))
+        raise fail(str(error)) from None
     try:
         body_shape = body.parse_shape(shape)
     except (ValueError, OSError) as error:
-        _fail(f"--shape {shape}: {error}")
+        raise fail(f"--shape {shape}: {error}") from None
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as error:
-        _fail(f"{out}: cannot create the output folder ({error})")
+        raise fail(f"{out}: cannot create the output folder ({error})") from None
     if motion_data is None:
         write_rest_body(out, body.rest(body_shape), body.faces)
         console.print(f"wrote {out / 'rest_body.obj'} and {out / 'rest_joints.json'} (metres, "

@@ -1,5 +1,4 @@
-"""``run_attribution`` (the work behind ``gnngarment attribute``) and the command's
-input errors."""
+"""``run_attribution``: the heatmap files of one attribution, and its input errors."""
 
 from __future__ import annotations
 
@@ -9,7 +8,7 @@ import numpy as np
 import pytest
 
 from gnngarment.attribution import Attribution
-from gnngarment.attribution.commands import run_attribution
+from gnngarment.attribution.heatmap_files import run_attribution
 from gnngarment.data.body_inputs import BodyMotionInputs, BodyShapeInputs
 from tests.attribution.conftest import build
 
@@ -72,46 +71,3 @@ def test_bad_options(tmp_path, garment, kwargs, message) -> None:
     with pytest.raises(ValueError, match=message):
         run_attribution(model, *garment, shape, motion, tmp_path, n_steps=2, **kwargs)
     assert list(tmp_path.iterdir()) == []
-
-
-def test_command_reports_a_missing_checkpoint(tmp_path) -> None:
-    import typer
-    from typer.testing import CliRunner
-
-    from gnngarment.attribution.commands import register
-
-    app = typer.Typer()
-    register(app)
-
-    @app.command("noop")
-    def noop() -> None:  # a second command, so typer keeps "attribute" as a subcommand
-        pass
-
-    result = CliRunner().invoke(app, ["attribute", str(tmp_path / "none.pt"),
-                                      str(tmp_path / "g.obj"), "--out", str(tmp_path)])
-    assert result.exit_code == 2
-    assert "checkpoint not found" in result.output
-    result = CliRunner().invoke(app, ["attribute", "a.pt", "g.obj", "--out", "o",
-                                      "--target", "face"])
-    assert result.exit_code == 2 and "--target must be one of" in result.output
-
-
-def test_a_garment_off_the_body_is_refused_before_attribution(tmp_path) -> None:
-    """The placement check of ``animate`` runs here too: a garment 3 m beside the body
-    exits 2 naming the file before integrated gradients run, and writes nothing."""
-    import trimesh
-    from typer.testing import CliRunner
-
-    from gnngarment.cli import app
-    from gnngarment.paths import SHIPPED_MODEL
-    from tests.meshes import tube
-
-    pos, faces = tube(12, 16)
-    far = tmp_path / "far.obj"
-    trimesh.Trimesh(pos + np.array([3.0, 0.0, 1.0]), faces, process=False).export(far)
-    out = tmp_path / "out"
-    result = CliRunner().invoke(app, ["attribute", str(SHIPPED_MODEL), str(far), "--out",
-                                      str(out), "--n-steps", "2", "--duration", "0.2"])
-    assert result.exit_code == 2, result.output
-    assert "far.obj: the garment is not on the rest body" in " ".join(result.output.split())
-    assert "Traceback" not in result.output and not out.exists()

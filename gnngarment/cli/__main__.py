@@ -1,0 +1,5 @@
+"""``python -m gnngarment.cli``."""
+
+from gnngarment.cli import main
+
+main()
