@@ -318,7 +318,7 @@ def plot_profiles(path: Path, profiles: dict, names: list[str]) -> None:
     from matplotlib.figure import Figure
     from matplotlib.ticker import MaxNLocator
 
-    from gnngarment.attribution.atomic import write_bytes_atomic
+    from gnngarment.geometry.files import atomic_write_bytes
 
     garments_seen = sorted({key[0] for key in profiles})
     figure = Figure(figsize=(4.6 * len(garments_seen), 3.6))
@@ -348,7 +348,7 @@ def plot_profiles(path: Path, profiles: dict, names: list[str]) -> None:
     figure.tight_layout()
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=110)
-    write_bytes_atomic(path, buffer.getvalue())
+    atomic_write_bytes(path, buffer.getvalue())
 
 
 if __name__ == "__main__":

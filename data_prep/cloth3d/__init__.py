@@ -16,7 +16,6 @@ metres, radians):
 - errors: :class:`Cloth3DError` (a ``ValueError`` whose message names the file)
 """
 
-from data_prep.cloth3d.atomic import atomic_write
 from data_prep.cloth3d.errors import Cloth3DError
 from data_prep.cloth3d.frames import from_world, to_world, world_transform, z_rotation
 from data_prep.cloth3d.info import GENDER_NAMES, read_info, write_info
@@ -40,6 +39,7 @@ from data_prep.cloth3d.sequence import (
     read_sequence,
     write_sequence,
 )
+from gnngarment.geometry.files import atomic_write
 
 __all__ = [
     "DEFAULT_FPS", "GARMENT_NAMES", "GENDER_NAMES", "Cloth3DError", "Cloth3DGarment",

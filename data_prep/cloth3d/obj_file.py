@@ -13,7 +13,7 @@ from typing import BinaryIO
 
 import numpy as np
 
-from data_prep.cloth3d.atomic import atomic_write
+from gnngarment.geometry.files import atomic_write
 
 # A vertex line as gnngarment's OBJ reader sees one: first word exactly "v".
 _VERTEX_LINE = re.compile(rb"^[ \t]*v[ \t]", re.MULTILINE)

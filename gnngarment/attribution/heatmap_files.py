@@ -11,7 +11,6 @@ from typing import Any
 
 import numpy as np
 
-from gnngarment.attribution.atomic import write_bytes_atomic
 from gnngarment.attribution.attribution import HEAT_CHANNELS, OUTPUTS, TARGET_KINDS
 from gnngarment.attribution.colors import SCALES
 from gnngarment.attribution.frame_inputs import FrameInputs
@@ -21,6 +20,7 @@ from gnngarment.attribution.ply import write_attribution_ply
 from gnngarment.attribution.render import render_attribution
 from gnngarment.attribution.targets import geodesic_region, largest_output_vertex
 from gnngarment.data.body_inputs import BodyMotionInputs, BodyShapeInputs
+from gnngarment.geometry.files import atomic_write_bytes
 from gnngarment.model.deformer import GarmentDeformer
 
 
@@ -113,5 +113,5 @@ def run_attribution(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,
             "support": field.support, "support_hops": field.support_hops}
     json_path = out / f"{stem}.json"
     summary["files"]["json"] = str(json_path)
-    write_bytes_atomic(json_path, json.dumps(summary, indent=2).encode())
+    atomic_write_bytes(json_path, json.dumps(summary, indent=2).encode())
     return summary

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from gnngarment.attribution.atomic import write_bytes_atomic
 from gnngarment.attribution.colors import DEFAULT_COLORMAP, heat_colors, normalise_heat
+from gnngarment.geometry.files import atomic_write_bytes
 
 
 def write_attribution_ply(path: str | Path, pos: np.ndarray, faces: np.ndarray,
@@ -42,4 +42,4 @@ def write_attribution_ply(path: str | Path, pos: np.ndarray, faces: np.ndarray,
     mesh = trimesh.Trimesh(vertices=pos, faces=faces, vertex_colors=colors, process=False)
     mesh.vertex_attributes["attribution"] = heat.astype(np.float32)
     mesh.vertex_attributes["quality"] = heat.astype(np.float32)
-    return write_bytes_atomic(path, export_ply(mesh, encoding="binary"))
+    return atomic_write_bytes(path, export_ply(mesh, encoding="binary"))

@@ -8,13 +8,13 @@ from pathlib import Path
 
 import numpy as np
 
-from gnngarment.attribution.atomic import write_bytes_atomic
 from gnngarment.attribution.colors import (
     DEFAULT_COLORMAP,
     LOG_DECADES,
     heat_colors,
     normalise_heat,
 )
+from gnngarment.geometry.files import atomic_write_bytes
 
 #: ``(elevation, azimuth)`` in degrees of the default views of a Z-up garment: front
 #: (camera on −Y, the body's front) and back.
@@ -99,7 +99,7 @@ def render_comparison(path: str | Path, pos: np.ndarray, faces: np.ndarray,
         figure.suptitle(suptitle, fontsize=10)
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=dpi)
-    return write_bytes_atomic(path, buffer.getvalue())
+    return atomic_write_bytes(path, buffer.getvalue())
 
 
 def _face_shading(pos: np.ndarray, faces: np.ndarray) -> np.ndarray:

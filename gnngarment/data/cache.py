@@ -198,11 +198,6 @@ def write_topology(root: Path, key: str, hierarchy: PoolHierarchy) -> Path:
     return path
 
 
-def write_json_atomic(path: Path, payload: dict) -> None:
-    """JSON written to a temp file and renamed (the manifest is the commit point)."""
-    atomic_write_bytes(path, json.dumps(payload, indent=2, sort_keys=True).encode())
-
-
 def read_manifest(root: str | Path) -> dict:
     """The cache's manifest, checked for format version.
 
@@ -304,5 +299,7 @@ def write_manifest(root: str | Path, splits: dict[str, list[str]],
     manifest = {"format_version": CACHE_FORMAT_VERSION, "splits": splits,
                 "sequences": sequences, "files": files, "sizes": sizes, "hash": digest,
                 **(extra or {})}
-    write_json_atomic(root / "manifest.json", manifest)
+    # Written last, atomically: the manifest is the cache's commit point.
+    atomic_write_bytes(root / "manifest.json",
+                       json.dumps(manifest, indent=2, sort_keys=True).encode())
     return manifest

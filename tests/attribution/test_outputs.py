@@ -88,10 +88,10 @@ def test_bad_outputs(tmp_path, mesh_and_heat, call, message) -> None:
 
 
 def test_atomic_write_is_readable_and_keeps_the_mode(tmp_path) -> None:
-    from gnngarment.attribution.atomic import write_bytes_atomic
+    from gnngarment.geometry.files import atomic_write_bytes
 
-    path = write_bytes_atomic(tmp_path / "sub" / "a.bin", b"one")
+    path = atomic_write_bytes(tmp_path / "sub" / "a.bin", b"one")
     assert path.read_bytes() == b"one" and path.stat().st_mode & 0o777 == 0o644
     path.chmod(0o600)
-    write_bytes_atomic(path, b"two")
+    atomic_write_bytes(path, b"two")
     assert path.read_bytes() == b"two" and path.stat().st_mode & 0o777 == 0o600

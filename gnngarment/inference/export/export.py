@@ -27,8 +27,7 @@ from numbers import Integral
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from gnngarment.geometry.files import FolderLock
-from gnngarment.inference.export.atomic import atomic_write_bytes
+from gnngarment.geometry.files import FolderLock, atomic_write_bytes
 from gnngarment.inference.export.gltf import write_glb
 from gnngarment.inference.export.obj_sequence import frame_path, write_obj, write_obj_sequence
 from gnngarment.inference.export.point_cache import write_point_cache

@@ -37,9 +37,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from gnngarment.body.skeleton import JOINT_NAMES
+from gnngarment.geometry.files import atomic_write_bytes
 from gnngarment.geometry.normals import vertex_normals
 from gnngarment.geometry.texture_coordinates import SeamSplit, split_uv_seams
-from gnngarment.inference.export.atomic import atomic_write_bytes
 from gnngarment.inference.export.gltf_reader import evaluate_mesh_node, read_glb
 from gnngarment.inference.export.skeleton_animation import (
     SkeletonAnimation,

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from gnngarment.geometry.files import atomic_write_bytes
 from gnngarment.geometry.texture_coordinates import check_texture_coordinates
-from gnngarment.inference.export.atomic import atomic_write_bytes
 
 #: Decimals written per coordinate: 1 µm, far below any garment detail.
 DECIMALS = 6

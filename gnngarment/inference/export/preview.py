@@ -17,8 +17,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from gnngarment.geometry.files import atomic_write_bytes
 from gnngarment.geometry.normals import face_normals, vertex_normals
-from gnngarment.inference.export.atomic import atomic_write_bytes
 from gnngarment.inference.export.validation import check_animation
 
 if TYPE_CHECKING:
