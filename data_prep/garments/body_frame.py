@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from gnngarment.geometry.graph import largest_component as graph_largest_component
+
 if TYPE_CHECKING:
     from data_prep.garments.body_distance import BodyDistance
     from data_prep.garments.measurements import BodyMeasurements
@@ -79,22 +81,8 @@ class BodyFrame:
 
 
 def largest_component(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Keep the largest connected component (Anny's body without tongue and eyes).
-
-    Returns:
-        vertices ``(N', 3)`` and faces ``(F', 3)`` re-indexed into them.
-    """
-    import scipy.sparse as sp
-    from scipy.sparse.csgraph import connected_components
-
-    faces = np.asarray(faces, dtype=np.int64)
-    n = len(vertices)
-    rows = faces[:, [0, 1, 2]].ravel()
-    cols = faces[:, [1, 2, 0]].ravel()
-    graph = sp.coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
-    _, labels = connected_components(graph, directed=False)
-    largest = np.argmax(np.bincount(labels[faces[:, 0]]))
-    keep = np.flatnonzero(labels == largest)
-    remap = np.full(n, -1, dtype=np.int64)
-    remap[keep] = np.arange(len(keep))
-    return np.asarray(vertices)[keep], remap[faces[labels[faces[:, 0]] == largest]]
+    """Keep the largest connected component (Anny's body without tongue and eyes):
+    vertices ``(N', 3)`` and faces ``(F', 3)`` re-indexed into them
+    (:func:`gnngarment.geometry.graph.largest_component`)."""
+    keep, kept_faces = graph_largest_component(faces, len(vertices))
+    return np.asarray(vertices)[keep], kept_faces

@@ -29,6 +29,7 @@ from gnngarment.body.body_model import BodyModel, PosedBody, RestBody
 from gnngarment.body.motion import Motion
 from gnngarment.body.rotations import rotation_between
 from gnngarment.body.skeleton import JOINT_NAMES, JOINT_PARENTS, NUM_JOINTS, forward_kinematics
+from gnngarment.geometry.graph import largest_component
 
 ANNY_PHENOTYPES: tuple[str, ...] = ("gender", "age", "muscle", "weight", "height", "proportions")
 
@@ -206,25 +207,6 @@ def load_anny() -> Any:
     return model
 
 
-def _largest_component(faces: np.ndarray, num_vertices: int) -> tuple[np.ndarray, np.ndarray]:
-    """(vertex indices ``(N_b,)``, re-indexed faces ``(F_b, 3)``) of the largest component."""
-    import scipy.sparse
-    from scipy.sparse.csgraph import connected_components
-
-    rows = np.concatenate([faces[:, 0], faces[:, 1], faces[:, 2]])
-    cols = np.concatenate([faces[:, 1], faces[:, 2], faces[:, 0]])
-    graph = scipy.sparse.coo_matrix(
-        (np.ones(len(rows)), (rows, cols)), shape=(num_vertices, num_vertices)
-    )
-    _, labels = connected_components(graph, directed=False)
-    largest = np.argmax(np.bincount(labels))
-    keep = np.flatnonzero(labels == largest)
-    remap = -np.ones(num_vertices, dtype=np.int64)
-    remap[keep] = np.arange(len(keep))
-    face_keep = np.all(labels[faces] == largest, axis=1)
-    return keep, remap[faces[face_keep]]
-
-
 @dataclasses.dataclass(frozen=True)
 class _AnnyRest:
     points: torch.Tensor  # (N_b, 24, 4) per-joint weighted rest points (see _rest_for)
@@ -258,7 +240,7 @@ class AnnyBodyModel(BodyModel):
         if all_faces.shape[1] != 3:
             raise RuntimeError(f"expected a triangle mesh from Anny, got faces {all_faces.shape}")
         num_vertices = int(self.anny.template_vertices.shape[0])
-        self.body_vertex_indices, self._faces = _largest_component(all_faces, num_vertices)
+        self.body_vertex_indices, self._faces = largest_component(all_faces, num_vertices)
         self._weights = self.anny.vertex_bone_weights.detach()[self.body_vertex_indices]
         self._indices = self.anny.vertex_bone_indices.detach()[self.body_vertex_indices]
         self._cache: collections.OrderedDict[AnnyShape, _AnnyRest] = collections.OrderedDict()

@@ -52,3 +52,20 @@ def connected_components(edge_index: np.ndarray, num_vertices: int) -> np.ndarra
     relabel = np.empty_like(order)
     relabel[order] = np.arange(len(order))
     return relabel[labels].astype(np.int64)
+
+
+def largest_component(faces: np.ndarray, num_vertices: int) -> tuple[np.ndarray, np.ndarray]:
+    """The largest connected component of a triangle mesh (most vertices): e.g. Anny's
+    body without its tongue and eyes.
+
+    Shapes:
+        faces ``(F, 3)`` → kept vertex indices ``(N', )`` (ascending) and the faces of the
+        component ``(F', 3)`` re-indexed into them.
+    """
+    faces = np.asarray(faces, dtype=np.int64)
+    labels = connected_components(edge_index_from_faces(faces, num_vertices), num_vertices)
+    largest = np.argmax(np.bincount(labels))
+    keep = np.flatnonzero(labels == largest)
+    remap = np.full(num_vertices, -1, dtype=np.int64)
+    remap[keep] = np.arange(len(keep))
+    return keep, remap[faces[labels[faces[:, 0]] == largest]]
