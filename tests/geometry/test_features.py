@@ -51,3 +51,15 @@ def test_joint_distances() -> None:
     pos = np.array([[0.0, 0, 0], [3, 4, 0]])
     joints = np.array([[0.0, 0, 0], [0, 0, 2], [3, 4, 0]])
     np.testing.assert_allclose(joint_distances(pos, joints), [[0, 2, 5], [5, np.sqrt(29), 0]])
+
+
+def test_largest_component_keeps_the_biggest_piece_reindexed() -> None:
+    """Anny's mesh is the body plus tongue and eyes: the body is what is kept."""
+    from gnngarment.geometry.graph import largest_component
+    from tests.meshes import random_disk, tube, union
+
+    pos, faces = union(random_disk(40, 1), tube(10, 12))  # disk first: 40 + 120 vertices
+    keep, kept = largest_component(faces, len(pos))
+    assert len(keep) == 120 and keep.min() == 40
+    assert kept.min() == 0 and kept.max() == 119 and len(kept) == 2 * 9 * 12
+    assert np.allclose(pos[keep][kept], pos[faces[faces.min(axis=1) >= 40]])
