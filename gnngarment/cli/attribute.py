@@ -14,6 +14,13 @@ from gnngarment.attribution.colors import SCALES
 from gnngarment.attribution.heatmap_files import run_attribution
 from gnngarment.cli.errors import fail
 
+#: The option a problem found by :func:`run_attribution` comes from (its messages name
+#: its own arguments: the frame index, the target vertices, the radius).
+OPTION_OF_PROBLEM = (("frame index", "--frame"), ("target vertex", "--vertex"),
+                     ("region centre", "--vertex"), ("target 'vertex' takes", "--vertex"),
+                     ("target 'region' needs", "--vertex"), ("target 'all' takes", "--vertex"),
+                     ("radius", "--radius"))
+
 
 def attribute_command(
     checkpoint: Annotated[Path, typer.Argument(help="Trained model checkpoint (.pt).")],
@@ -144,7 +151,9 @@ def attribute_command(
                 target=target, vertices=vertex or None, radius=radius, output=output,
                 n_steps=n_steps, heat=heat, scale=scale, source=str(garment_mesh))
     except (ValueError, MeshError) as error:
-        raise fail(str(error)) from None
+        option = next((name for start, name in OPTION_OF_PROBLEM
+                       if str(error).startswith(start)), None)
+        raise fail(f"{option}: {error}" if option else str(error)) from None
     console.print(
         f"{summary['target']} {summary['output']}: f(X) = {summary['value']:.4g}, "
         f"f(0) = {summary['baseline_value']:.4g}, completeness delta "

@@ -404,10 +404,10 @@ CASES: dict[str, Case] = {
         "--scale must be one of linear, log, got 'cubic'"),
     "attribute-frame": Case(
         [*ATTRIBUTE, "--frame", "9999"],
-        "frame index 9999 is out of range for a motion of 7 frames"),
+        "--frame: frame index 9999 is out of range for a motion of 7 frames"),
     "attribute-vertex": Case(
         [*ATTRIBUTE, "--vertex", "99999"],
-        "target vertex 99999 is out of range for a garment of 300 vertices"),
+        "--vertex: target vertex 99999 is out of range for a garment of 300 vertices"),
     "attribute-body-model": Case(
         [*ATTRIBUTE, "--body-model", "smplx"],
         "--body-model must be 'anny' or 'smpl', got 'smplx'"),
