@@ -15,6 +15,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from gnngarment.geometry.normals import face_normals
+
 
 def closest_points_on_triangles(
     p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray
@@ -111,9 +113,7 @@ class _Component:
         self.vertices = vertices
         self.faces = faces
         corners = vertices[faces]
-        normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
-        self.face_normals = normals
+        normals = self.face_normals = face_normals(vertices, faces)
         # Angle-weighted vertex pseudo-normals.
         vertex_normals = np.zeros_like(vertices)
         for k in range(3):

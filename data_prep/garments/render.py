@@ -11,6 +11,8 @@ from typing import Any
 
 import numpy as np
 
+from gnngarment.geometry.normals import face_normals
+
 
 def view_rotation(azimuth_deg: float = 20.0, elevation_deg: float = 10.0) -> np.ndarray:
     """``(3, 3)`` world → camera rotation: camera X right, Y up, Z towards the viewer.
@@ -47,8 +49,7 @@ def draw_meshes(ax: Any, meshes: list[tuple[np.ndarray, np.ndarray, tuple[float,
     for index, (pos, faces, rgb, alpha) in enumerate(meshes):
         camera = np.asarray(pos) @ rotation.T
         corners = camera[np.asarray(faces)]
-        normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-        normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-15)
+        normal = face_normals(camera, faces)
         facing = normal[:, 2] >= 0
         shade = np.abs(normal @ light)
         shade = np.where(facing, 0.35 + 0.65 * shade, 0.2 + 0.35 * shade)

@@ -15,6 +15,7 @@ from gnngarment.attribution.colors import (
     normalise_heat,
 )
 from gnngarment.geometry.files import atomic_write_bytes
+from gnngarment.geometry.normals import face_normals
 
 #: ``(elevation, azimuth)`` in degrees of the default views of a Z-up garment: front
 #: (camera on −Y, the body's front) and back.
@@ -105,9 +106,7 @@ def render_comparison(path: str | Path, pos: np.ndarray, faces: np.ndarray,
 def _face_shading(pos: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """``(F,)`` brightness in ``[0.55, 1]``: two-sided Lambert light from the camera's
     side, so folds stay readable under the colour map."""
-    corners = pos[faces]
-    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+    normals = face_normals(pos, faces)
     light = np.array([0.3, -0.8, 0.5]) / np.linalg.norm([0.3, -0.8, 0.5])
     return 0.55 + 0.45 * np.abs(normals @ light)
 

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from gnngarment.geometry.normals import face_normals
+
 
 def surface_area(pos: np.ndarray, faces: np.ndarray) -> float:
     """Total triangle area, in squared input units."""
-    corners = np.asarray(pos, dtype=np.float64)[np.asarray(faces)]
-    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    cross = face_normals(np.asarray(pos, dtype=np.float64), faces, normalize=False)
     return float(0.5 * np.linalg.norm(cross, axis=1).sum())
 
 
@@ -21,9 +22,8 @@ def mesh_scale(pos: np.ndarray, faces: np.ndarray) -> float:
 
 def vertex_areas(pos: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """``(N,)`` lumped (barycentric) vertex areas: a third of each incident triangle."""
-    corners = np.asarray(pos, dtype=np.float64)[np.asarray(faces)]
     area = 0.5 * np.linalg.norm(
-        np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+        face_normals(np.asarray(pos, dtype=np.float64), faces, normalize=False), axis=1)
     areas = np.zeros(len(pos))
     for corner in range(3):
         np.add.at(areas, np.asarray(faces)[:, corner], area / 3.0)

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gnngarment.geometry.errors import MeshError
+from gnngarment.geometry.normals import face_normals
 
 #: A face is degenerate when its area is below this fraction of the squared bounding-box
 #: diagonal. Relative, so the test does not depend on units (metres vs centimetres).
@@ -99,9 +100,7 @@ def check_mesh(pos: np.ndarray, faces: np.ndarray, source: str = "<mesh>") -> Me
 
     repeated = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (
         faces[:, 0] == faces[:, 2])
-    corners = pos[faces]
-    double_area = np.linalg.norm(
-        np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+    double_area = np.linalg.norm(face_normals(pos, faces, normalize=False), axis=1)
     diagonal = float(np.linalg.norm(pos.max(axis=0) - pos.min(axis=0)))
     tiny = double_area <= 2 * DEGENERATE_AREA_FRACTION * max(diagonal, 1e-300) ** 2
     degenerate = np.flatnonzero(repeated | tiny)
