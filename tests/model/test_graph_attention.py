@@ -316,9 +316,8 @@ def test_pyg_variant_of_the_deformer_equals_csr() -> None:
         config = tiny_config(attention=attention)
         torch.manual_seed(0)
         model = GarmentDeformer(config)
-        # The deformer builds its layers from config.attention; set_attention makes sure
-        # (and keeps the weights, which are the same either way).
-        set_attention(model, config.attention)
+        # The deformer builds its layers from config.attention (issue 16: it once ignored
+        # it; checked on the model as built, with no set_attention before).
         kind = GATConv if attention == "pyg" else GraphAttention
         layers = [m for m in model.modules() if hasattr(m, "att_src")]
         assert layers and all(isinstance(m, kind) for m in layers)
@@ -330,6 +329,9 @@ def test_pyg_variant_of_the_deformer_equals_csr() -> None:
     for name in ("weights", "blend_shapes", "posed"):
         torch.testing.assert_close(getattr(outputs["csr"], name),
                                    getattr(outputs["pyg"], name), rtol=1e-4, atol=1e-5)
+    # set_attention swaps a built model's layers (to compare on one trained model).
+    swapped = set_attention(GarmentDeformer(tiny_config(attention="csr")), "pyg")
+    assert all(isinstance(m, GATConv) for m in swapped.modules() if hasattr(m, "att_src"))
 
 
 def test_unknown_attention_is_rejected() -> None:
