@@ -1,5 +1,5 @@
 """Write docs/cli.md from the command-line interface itself (typer's command objects), so
-the reference cannot drift from the code: ``tests/test_cli_reference.py`` fails when
+the reference cannot drift from the code: ``tests/cli/test_reference.py`` fails when
 the committed page differs from what this prints.
 
     .venv/bin/python docs/build_cli_reference.py            # rewrites docs/cli.md
