@@ -48,9 +48,9 @@ from gnngarment.attribution import (
     mass_profile,
     render_comparison,
 )
+from gnngarment.body.weight_transfer import transfer_body_weights
 from gnngarment.config import load_config
 from gnngarment.data.pair import GarmentBodyPair
-from gnngarment.evaluation.baselines import transfer_body_weights
 from gnngarment.geometry.hierarchy import PoolHierarchy, PoolLevel
 from gnngarment.geometry.prepare import GarmentPreparationConfig, prepare_garment
 from gnngarment.model.config import ModelConfig

@@ -322,7 +322,7 @@ def make_garment(design: DesignPlan, body: BodyPlan) -> GarmentDesign:
     if design.garment_type in WAIST_SUPPORTED:
         return GarmentDesign(garment.pos, garment.faces, band, 0)
     if is_strapless(style):
-        from gnngarment.evaluation.baselines import transfer_body_weights
+        from gnngarment.body.weight_transfer import transfer_body_weights
 
         weights = transfer_body_weights(garment.pos[band], rest.vertices.numpy(),
                                         body_model.skinning_weights())
@@ -351,13 +351,13 @@ def drape_and_prepare_garment(task: tuple[str, DesignPlan, BodyPlan, DataConfig,
         import torch
 
         from data_prep.simulate import SimulationFailed, drape_garment, load_simulation_settings
+        from gnngarment.body.weight_transfer import transfer_body_weights
         from gnngarment.data.cache import (
             GarmentRecord,
             topology_key,
             write_garment,
             write_topology,
         )
-        from gnngarment.evaluation.baselines import transfer_body_weights
         from gnngarment.geometry.prepare import GarmentPreparationConfig, prepare_garment
 
         torch.set_num_threads(1)

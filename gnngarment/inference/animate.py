@@ -85,7 +85,7 @@ def garment_pair(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,
     body_weights = None
     if config.weight_prior == "body":
         # Imported here: the evaluation package imports much of the library.
-        from gnngarment.evaluation.baselines import transfer_body_weights
+        from gnngarment.body.weight_transfer import transfer_body_weights
 
         if body.skinning_weights is None:
             raise ValueError(f"{source}: the model's weight_prior 'body' needs the body's "

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 import torch
 
+from gnngarment.body.weight_transfer import transfer_body_weights
 from gnngarment.data.body_inputs import BodyShapeInputs
-from gnngarment.evaluation.baselines import transfer_body_weights
 from gnngarment.inference.animate import garment_pair
 from gnngarment.model import GarmentDeformer
 from tests.meshes import tube

@@ -1,4 +1,5 @@
-"""Baselines evaluated in the same harness as the model."""
+"""Skinning weights carried from a body to a garment on it: the body-skinning baseline,
+the model's weight prior and the pin weights of the dataset builder all use them."""
 
 from __future__ import annotations
 
