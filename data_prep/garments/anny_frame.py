@@ -4,7 +4,8 @@ For tests and pictures of the garment generator only. The library's body interfa
 (``gnngarment.body``, T-pose canonical rest, exact joint mapping) is the source of
 bodies for the dataset; this module approximates it with Anny's bone heads so the
 garment code does not depend on that package: joints are the heads of the bones
-listed in :data:`ANNY_JOINT_BONES` (averaged for feet and hands), the mesh is the
+listed in :data:`gnngarment.body.anny_model.ANNY_JOINT_BONES` (averaged for feet and
+hands; the library's one table), the mesh is the
 largest connected component (the body without tongue and eyes).
 """
 
@@ -15,21 +16,6 @@ from typing import Any
 import numpy as np
 
 from data_prep.garments.body_frame import JOINT_NAMES, BodyFrame, largest_component
-
-_TOES = ("toe1-1", "toe2-1", "toe3-1", "toe4-1", "toe5-1")
-_FINGERS = ("finger2-1", "finger3-1", "finger4-1", "finger5-1")
-
-#: Canonical joint → Anny bone(s) whose head gives its position.
-ANNY_JOINT_BONES: dict[str, tuple[str, ...]] = {
-    "pelvis": ("root",), "spine1": ("spine04",), "spine2": ("spine02",),
-    "spine3": ("spine01",), "neck": ("neck01",), "head": ("head",),
-    **{f"{s}_{joint}": (f"{bone}.{s}",) for s in ("L", "R") for joint, bone in (
-        ("hip", "upperleg01"), ("knee", "lowerleg01"), ("ankle", "foot"),
-        ("collar", "clavicle"), ("shoulder", "upperarm01"), ("elbow", "lowerarm01"),
-        ("wrist", "wrist"))},
-    **{f"{s}_foot": tuple(f"{t}.{s}" for t in _TOES) for s in ("L", "R")},
-    **{f"{s}_hand": tuple(f"{f}.{s}" for f in _FINGERS) for s in ("L", "R")},
-}  # fmt: skip
 
 
 def _rotation_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -61,6 +47,8 @@ def anny_body_frame(model: Any = None, pose: str = "A",
     """
     import torch
 
+    from gnngarment.body.anny_model import ANNY_JOINT_BONES
+
     if pose not in ("A", "T"):
         raise ValueError(f"pose must be 'A' or 'T', got {pose!r}")
     if model is None:
@@ -84,7 +72,7 @@ def anny_body_frame(model: Any = None, pose: str = "A",
             target = np.array([sign, 0.0, 0.0])
             chain = [f"upperarm01.{side}", f"lowerarm01.{side}", f"wrist.{side}"]
             aims = [heads[index[f"lowerarm01.{side}"]], heads[index[f"wrist.{side}"]],
-                    heads[[index[f"{f}.{side}"] for f in _FINGERS]].mean(axis=0)]
+                    heads[[index[b] for b in ANNY_JOINT_BONES[f"{side}_hand"]]].mean(axis=0)]
             total = np.eye(3)
             for bone, aim in zip(chain, aims, strict=True):
                 rotation = _rotation_between(aim - heads[index[bone]], total.T @ target)

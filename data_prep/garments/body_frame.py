@@ -8,19 +8,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from gnngarment.body.skeleton import JOINT_INDEX, JOINT_NAMES
 from gnngarment.geometry.graph import largest_component as graph_largest_component
 
 if TYPE_CHECKING:
     from data_prep.garments.body_distance import BodyDistance
     from data_prep.garments.measurements import BodyMeasurements
 
-#: The 24 canonical joints, SMPL order (``docs/garments.md``, DESIGN.md).
-JOINT_NAMES: tuple[str, ...] = (
-    "pelvis", "L_hip", "R_hip", "spine1", "L_knee", "R_knee", "spine2", "L_ankle",
-    "R_ankle", "spine3", "L_foot", "R_foot", "neck", "L_collar", "R_collar", "head",
-    "L_shoulder", "R_shoulder", "L_elbow", "R_elbow", "L_wrist", "R_wrist", "L_hand", "R_hand",
-)  # fmt: skip
-JOINT: dict[str, int] = {name: i for i, name in enumerate(JOINT_NAMES)}
+#: The 24 canonical joints and their indices: the skeleton's (one home).
+JOINT = JOINT_INDEX
 
 
 @dataclasses.dataclass(eq=False)
