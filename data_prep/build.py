@@ -219,17 +219,6 @@ PLAN_KEYS = ("seed", "garment_types", "garments", "garment_vertices", "bodies",
 PLACE_KEYS = ("output", "workers", "simulation", "executor", "ray_address")
 
 
-def _plan_fields(plan: Any) -> dict[str, Any]:
-    """A plan's hashed fields; a canonical motion hashes as before variants existed."""
-    fields = asdict(plan)
-    for motion in [fields] if isinstance(plan, MotionPlan) else (
-            [fields["motion"]] if isinstance(plan, SequencePlan) else []):
-        for key in ("speed", "amplitude"):
-            if motion[key] == 1.0:
-                del motion[key]
-    return fields
-
-
 def content_inputs(config: DataConfig, settings: Any) -> dict[str, Any]:
     """What every sequence's and drape's content depends on besides its own plan: not
     where the dataset lives, how many processes build it or where, the path of the
@@ -239,8 +228,12 @@ def content_inputs(config: DataConfig, settings: Any) -> dict[str, Any]:
 
 
 def sequence_inputs_hash(inputs: dict[str, Any], plan: SequencePlan) -> str:
-    """The hash a built sequence is recorded with (its ``.hash`` file)."""
-    return _hash({**inputs, "plan": _plan_fields(plan)})
+    """The hash a built sequence is recorded with (its ``.hash`` file). A canonical
+    motion (tempo and amplitude 1) is hashed without those two fields."""
+    fields = asdict(plan)
+    fields["motion"] = {key: value for key, value in fields["motion"].items()
+                        if key not in ("speed", "amplitude") or value != 1.0}
+    return _hash({**inputs, "plan": fields})
 
 
 def _hash(payload: Any) -> str:

@@ -14,7 +14,7 @@ See ``docs/garments.md``.
 """
 
 from data_prep.garments.anny_frame import anny_body_frame
-from data_prep.garments.body_frame import JOINT_NAMES, BodyFrame, largest_component
+from data_prep.garments.body_frame import BodyFrame, largest_component
 from data_prep.garments.checks import garment_problems, self_intersections
 from data_prep.garments.dress import DressStyle
 from data_prep.garments.garment import (
@@ -33,7 +33,7 @@ from data_prep.garments.trousers import TrousersStyle
 from data_prep.garments.tshirt import TShirtStyle
 
 __all__ = [
-    "DEFAULT_RESOLUTION", "GARMENT_TYPES", "JOINT_NAMES", "BodyFrame", "DressStyle", "Garment",
+    "DEFAULT_RESOLUTION", "GARMENT_TYPES", "BodyFrame", "DressStyle", "Garment",
     "GarmentError", "JumpsuitStyle", "SkirtStyle", "TShirtStyle", "TopStyle", "TrousersStyle",
     "anny_body_frame", "flared_skirt", "garment_problems", "largest_component",
     "make_garment", "sample_garment", "self_intersections", "synthetic_body",

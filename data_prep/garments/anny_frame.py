@@ -15,7 +15,8 @@ from typing import Any
 
 import numpy as np
 
-from data_prep.garments.body_frame import JOINT_NAMES, BodyFrame, largest_component
+from data_prep.garments.body_frame import BodyFrame, largest_component
+from gnngarment.body.skeleton import JOINT_NAMES
 
 
 def _rotation_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -15,10 +15,6 @@ if TYPE_CHECKING:
     from data_prep.garments.body_distance import BodyDistance
     from data_prep.garments.measurements import BodyMeasurements
 
-#: The 24 canonical joints and their indices: the skeleton's (one home).
-JOINT = JOINT_INDEX
-
-
 @dataclasses.dataclass(eq=False)
 class BodyFrame:
     """A rest body: closed triangle mesh + the 24 joints, Z up, metres, facing −Y.
@@ -59,7 +55,7 @@ class BodyFrame:
 
     def joint(self, name: str) -> np.ndarray:
         """``(3,)`` position of a joint by SMPL name (e.g. ``"L_shoulder"``)."""
-        return self.joints[JOINT[name]]
+        return self.joints[JOINT_INDEX[name]]
 
     @functools.cached_property
     def distance(self) -> BodyDistance:

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from data_prep.garments.body_frame import JOINT, BodyFrame
+from data_prep.garments.body_frame import BodyFrame
+from gnngarment.body.skeleton import JOINT_INDEX
 
 
 def _ellipsoid(center: tuple[float, float, float], radii: tuple[float, float, float],
@@ -76,7 +77,7 @@ def synthetic_body(arm_angle_deg: float = 0.0, scale: float = 1.0, girth: float 
     joints = np.zeros((24, 3))
 
     def put(name: str, xyz: tuple[float, float, float] | np.ndarray) -> None:
-        joints[JOINT[name]] = xyz
+        joints[JOINT_INDEX[name]] = xyz
 
     put("pelvis", (0, 0, 0.05))
     put("spine1", (0, 0.01, 0.15))
@@ -106,7 +107,7 @@ def synthetic_body(arm_angle_deg: float = 0.0, scale: float = 1.0, girth: float 
         _ellipsoid((0, -0.02, 0.7), (0.08, 0.1, 0.115)),
     ]
     for side in ("L", "R"):
-        j = {name: joints[JOINT[f"{side}_{name}"]] for name in
+        j = {name: joints[JOINT_INDEX[f"{side}_{name}"]] for name in
              ("shoulder", "elbow", "wrist", "hand", "hip", "knee", "ankle", "foot")}
         parts += [
             _capsule(j["shoulder"], j["elbow"], 0.048 * g),

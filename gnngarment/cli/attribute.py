@@ -6,13 +6,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
 
 from gnngarment.attribution.attribution import HEAT_CHANNELS, OUTPUTS, TARGET_KINDS
 from gnngarment.attribution.colors import SCALES
 from gnngarment.attribution.heatmap_files import run_attribution
-from gnngarment.cli.errors import fail
+from gnngarment.cli.errors import check_motion_options, fail, refuse_misplaced_garment
 
 #: The option a problem found by :func:`run_attribution` comes from (its messages name
 #: its own arguments: the frame index, the target vertices, the radius).
@@ -94,11 +93,7 @@ def attribute_command(
         raise fail(f"--scale must be one of {', '.join(SCALES)}, got '{scale}'")
     if body_model not in ("anny", "smpl"):
         raise fail(f"--body-model must be 'anny' or 'smpl', got '{body_model}'")
-    for option, value in (("--fps", fps), ("--duration", duration)):
-        if not (value > 0 and np.isfinite(value)):  # also NaN
-            raise fail(f"{option} must be a finite number > 0, got {value}")
-    if motion_up_axis not in ("auto", "y", "z"):
-        raise fail(f"--motion-up-axis must be auto, y or z, got '{motion_up_axis}'")
+    check_motion_options(fps, duration, motion_up_axis)
     from gnngarment.inference.output_folder import check_output_folder
 
     try:  # now, not when the results are written after the integrated gradients
@@ -136,14 +131,8 @@ def attribute_command(
             raise fail(f"{source_body}: {error}") from None
         pos = placed.pos
         console.print(f"placement: {placed.messages[0]}", highlight=False)
-    from gnngarment.inference.checks import check_garment_placement
-
-    findings = check_garment_placement(pos, faces, shape_inputs.rest_vertices, shape_inputs.faces)
-    for finding in findings:
-        console.print(f"{finding.severity}: {garment_mesh}: {finding.message}", highlight=False)
-    if any(f.severity == "error" for f in findings) and not ignore_placement:
-        raise fail(f"{garment_mesh}: the garment is not on the rest body (see above; fix it or "
-              "pass --source-body or --ignore-placement)")
+    refuse_misplaced_garment(console, pos, faces, shape_inputs, garment_mesh, ignore_placement,
+                             "--source-body or --ignore-placement")
     try:
         with console.status(f"integrated gradients ({n_steps} Gauss-Legendre points)"):
             summary = run_attribution(

@@ -9,7 +9,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from gnngarment.cli.errors import fail
+from gnngarment.cli.errors import check_motion_options, fail
 
 
 def write_rest_body(out: Path, rest, faces: np.ndarray) -> None:
@@ -77,11 +77,7 @@ def body_command(
 
     console = Console(stderr=True)
     start = time.perf_counter()
-    for option, value in (("--fps", fps), ("--duration", duration)):
-        if not (value > 0 and np.isfinite(value)):  # also NaN, which `<= 0` lets through
-            raise fail(f"{option} must be a finite number > 0, got {value}")
-    if motion_up_axis not in ("auto", "y", "z"):
-        raise fail(f"--motion-up-axis must be auto, y or z, got '{motion_up_axis}'")
+    check_motion_options(fps, duration, motion_up_axis)
     if model not in ("anny", "smpl"):
         raise fail(f"--model must be 'anny' or 'smpl', got '{model}'")
     try:

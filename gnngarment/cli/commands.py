@@ -15,13 +15,12 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from gnngarment.cli.errors import fail
+from gnngarment.cli.errors import check_motion_options, fail, refuse_misplaced_garment
 from gnngarment.threads import use_idle_cores
 
 app = typer.Typer(help="Animate any garment mesh with one learned model.",
                   no_args_is_help=True, add_completion=False)
 console = Console()
-
 
 
 @app.callback()
@@ -279,9 +278,7 @@ def prepare(
         raise fail(f"{config}: {error}") from None
     try:
         report = build_dataset(settings, workers=workers, log=console.print)
-    except RayMissingError as error:
-        raise fail(str(error)) from None
-    except (ValueError, OSError) as error:
+    except (RayMissingError, ValueError, OSError) as error:
         raise fail(str(error)) from None
     console.print(f"[green]done[/] in {report['seconds']:.0f} s: splits {report['splits']}, "
                   f"{len(report['failed_sequences'])} sequence(s) left out; "
@@ -468,11 +465,7 @@ def _check_animate_options(fps: float, duration: float, motion_up_axis: str,
     from gnngarment.inference.checks import UNIT_SCALES
     from gnngarment.inference.export import FORMATS
 
-    for option, value in (("--fps", fps), ("--duration", duration)):
-        if not (value > 0 and math.isfinite(value)):  # also NaN
-            raise fail(f"{option} must be a finite number > 0, got {value}")
-    if motion_up_axis not in ("auto", "y", "z"):
-        raise fail(f"--motion-up-axis must be auto, y or z, got '{motion_up_axis}'")
+    check_motion_options(fps, duration, motion_up_axis)
     unknown = [name for name in formats if name not in FORMATS]
     if unknown or not formats:
         raise fail(f"--format: unknown {unknown or 'empty list'}; choose from "
@@ -561,7 +554,6 @@ def animate(
     from gnngarment.geometry.errors import MeshError
     from gnngarment.geometry.mesh_io import load_mesh, load_textured_mesh
     from gnngarment.inference.animate import animate as run_animation
-    from gnngarment.inference.checks import check_garment_placement
     from gnngarment.inference.export import export_animation
     from gnngarment.inference.placement import place_garment
     from gnngarment.paths import SHIPPED_MODEL
@@ -595,14 +587,9 @@ def animate(
     pos = placed.pos
     for message in placed.messages:
         console.print(f"[yellow]placement:[/] {message}")
-    findings = check_garment_placement(pos, faces, body_inputs.rest_vertices, body_inputs.faces)
-    for finding in findings:
-        colour = "red" if finding.severity == "error" else "yellow"
-        console.print(f"[{colour}]{finding.severity}:[/] {garment_mesh}: {finding.message}")
-    if any(f.severity == "error" for f in findings) and not ignore_placement:
-        raise fail(f"{garment_mesh}: the garment is not on the rest body (see above; fix it "
-                   "or pass --source-body, --fix-units/--scale, --up-axis, --offset, or "
-                   "--ignore-placement)")
+    refuse_misplaced_garment(console, pos, faces, body_inputs, garment_mesh, ignore_placement,
+                             "--source-body, --fix-units/--scale, --up-axis, --offset, or "
+                             "--ignore-placement")
     if lock is None:
         lock = _hold_output_folder(context, out)
     frames = body_motion_inputs(body_model, shape, motion_value, model.config.body_vertices)

@@ -1,6 +1,11 @@
-"""The one way a command reports bad input: one line on stderr, exit code 2."""
+"""The one way a command reports bad input (one line on stderr, exit code 2), and the
+checks of options and garments that several commands share."""
 
 from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
 
 import typer
 from rich.console import Console
@@ -19,3 +24,45 @@ def fail(message: str) -> typer.Exit:
     # escaped: rich would drop "[low, high]" or ".[ray]" in a message as a markup tag.
     errors.print(f"[bold red]error:[/] {escape(message)}", highlight=False, soft_wrap=True)
     return typer.Exit(BAD_INPUT)
+
+
+#: Up axes a motion file may be read with (``--motion-up-axis``).
+MOTION_UP_AXES = ("auto", "y", "z")
+
+
+def check_motion_options(fps: float, duration: float, motion_up_axis: str) -> None:
+    """``--fps``, ``--duration`` and ``--motion-up-axis`` of the commands that build a
+    motion, before any loading.
+
+    Raises:
+        typer.Exit: (after the message) a bad value.
+    """
+    for option, value in (("--fps", fps), ("--duration", duration)):
+        if not (value > 0 and math.isfinite(value)):  # also NaN, which `<= 0` lets through
+            raise fail(f"{option} must be a finite number > 0, got {value}")
+    if motion_up_axis not in MOTION_UP_AXES:
+        raise fail(f"--motion-up-axis must be auto, y or z, got '{motion_up_axis}'")
+
+
+def refuse_misplaced_garment(console: Console, pos: Any, faces: Any, body: Any,
+                             garment_mesh: Path, ignore: bool, fixes: str) -> None:
+    """Print every placement finding of the garment on the rest ``body``
+    (:class:`~gnngarment.data.body_inputs.BodyShapeInputs`) and refuse it, before the
+    long work, when one is an error and ``ignore`` (``--ignore-placement``) is off.
+
+    Args:
+        fixes: the command's options that could fix it, for the message.
+
+    Raises:
+        typer.Exit: (after the message) the garment is not on the rest body.
+    """
+    from gnngarment.inference.checks import check_garment_placement
+
+    findings = check_garment_placement(pos, faces, body.rest_vertices, body.faces)
+    for finding in findings:
+        colour = "red" if finding.severity == "error" else "yellow"
+        console.print(f"[{colour}]{finding.severity}:[/] {garment_mesh}: {finding.message}",
+                      highlight=False)
+    if any(f.severity == "error" for f in findings) and not ignore:
+        raise fail(f"{garment_mesh}: the garment is not on the rest body (see above; fix it "
+                   f"or pass {fixes})")

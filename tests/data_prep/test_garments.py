@@ -22,9 +22,9 @@ from data_prep.garments import (
     synthetic_body,
 )
 from data_prep.garments.body_distance import BodyDistance
-from data_prep.garments.body_frame import JOINT
 from data_prep.garments.flips import delaunay_flips
 from data_prep.garments.measurements import ARM_L, ARM_R, HEAD, TRUNK
+from gnngarment.body.skeleton import JOINT_INDEX
 from gnngarment.geometry import (
     check_mesh,
     connected_components,
@@ -344,7 +344,7 @@ def _copy(garment: Garment) -> Garment:
 
 
 def test_joint_table_is_smpl_order() -> None:
-    assert JOINT["pelvis"] == 0 and JOINT["neck"] == 12 and JOINT["R_hand"] == 23
+    assert JOINT_INDEX["pelvis"] == 0 and JOINT_INDEX["neck"] == 12 and JOINT_INDEX["R_hand"] == 23
 
 
 def test_garment_error_is_a_value_error() -> None:
