@@ -6,8 +6,8 @@ import torch
 
 from gnngarment.data.dataset import TrainingBatch
 from gnngarment.model.deformer import DeformerOutput
-from gnngarment.training import losses
 from gnngarment.training.config import LossWeights, StageConfig
+from gnngarment.training.criteria import CRITERIA
 
 
 def stage_weights(stage: str, weights: LossWeights, stages: StageConfig) -> dict[str, float]:
@@ -26,35 +26,12 @@ def stage_weights(stage: str, weights: LossWeights, stages: StageConfig) -> dict
 
 def loss_terms(output: DeformerOutput, batch: TrainingBatch, names: list[str],
                collision_margin: float) -> dict[str, torch.Tensor]:
-    """Unweighted loss terms ``names`` of a batch's prediction (each a scalar)."""
-    pred = output.posed
-    terms: dict[str, torch.Tensor] = {}
-    for name in names:
-        if name == "vertex":
-            terms[name] = losses.vertex_loss(pred, batch.target)
-        elif name == "edge":
-            terms[name] = losses.edge_loss(pred, batch.target, batch.edges)
-        elif name == "normal":
-            terms[name] = losses.normal_loss(pred, batch.target, batch.faces)
-        elif name == "collision":
-            terms[name] = losses.collision_loss(pred, batch.body_points, batch.body_normals,
-                                                output.item, batch.body_item, collision_margin)
-        elif name == "gravity":
-            # Energy relative to the ground-truth heights: the gradient (each vertex's
-            # weight) is the same as for absolute heights, the value stays readable.
-            terms[name] = losses.gravity_loss(pred, batch.target, batch.vertex_mass,
-                                              int(batch.item.max()) + 1)
-        elif name == "blend_shape":
-            terms[name] = losses.blend_shape_loss(output.blend_shapes)
-        elif name == "stretch":
-            terms[name] = losses.stretch_loss(pred, batch.faces, batch.rest_inverse,
-                                              batch.rest_area)
-        elif name == "shear":
-            terms[name] = losses.shear_loss(pred, batch.faces, batch.rest_inverse,
-                                            batch.rest_area)
-        else:
-            raise ValueError(f"unknown loss term '{name}'")
-    return terms
+    """Unweighted loss terms ``names`` of a batch's prediction (each a scalar), each
+    computed by its criterion (:data:`~gnngarment.training.criteria.CRITERIA`)."""
+    unknown = [name for name in names if name not in CRITERIA]
+    if unknown:
+        raise ValueError(f"unknown loss term '{unknown[0]}' (known: {', '.join(CRITERIA)})")
+    return {name: CRITERIA[name](output, batch, collision_margin) for name in names}
 
 
 def stage_loss(output: DeformerOutput, batch: TrainingBatch, stage: str, weights: LossWeights,
