@@ -107,10 +107,6 @@ def mesh_collision_rate(pred: np.ndarray, body_vertices: np.ndarray,
     return rates
 
 
-#: A body vertex belongs to a joint's region when the joint moves it at least this much.
-REGION_WEIGHT = 0.1
-
-
 def far_joint_weight(weights: np.ndarray, rest_pos: np.ndarray, body_rest_vertices: np.ndarray,
                      body_skinning_weights: np.ndarray, radius: float = 0.20
                      ) -> dict[str, float]:
@@ -135,6 +131,8 @@ def far_joint_weight(weights: np.ndarray, rest_pos: np.ndarray, body_rest_vertic
         and frames, as fractions of each vertex's unit weight (0 = none, 1 = all).
     """
     from scipy.spatial import cKDTree
+
+    from gnngarment.body.joint_reach import REGION_WEIGHT
 
     weights = np.asarray(weights)
     if weights.ndim == 2:

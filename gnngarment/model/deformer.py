@@ -45,15 +45,16 @@ class DeformerContext:
         rest_pos: ``(ΣN, 3)``.
         ptr: ``(P + 1,)`` vertex offsets of the pairs.
         hierarchies: one per pair.
-        body_weights: ``(ΣN, 24)`` the pairs' transferred body skinning weights (the
-            ``body`` weight prior), or ``None`` when the model has no prior.
+        prior_logits: ``(ΣN, 24)`` the weight head's body-skinning prior
+            (:func:`body_prior_logits`, ``-inf`` on joints out of ``weight_reach``), or
+            ``None`` when the model has no prior.
     """
 
     fused: torch.Tensor
     rest_pos: torch.Tensor
     ptr: list[int]
     hierarchies: list[PoolHierarchy]
-    body_weights: torch.Tensor | None = None
+    prior_logits: torch.Tensor | None = None
     _graphs: dict[int, GraphLevels] = field(default_factory=dict, repr=False)
 
     @property
@@ -159,12 +160,13 @@ class GarmentDeformer(nn.Module):
         garment = self.garment_encoder(features, edge_index, style[pair_of_vertex])
         body = self.body_encoder(torch.stack([pair.body_distances for pair in pairs]))
         fused = garment * body[pair_of_vertex]
-        # Checked above: every pair has them when the head has the prior.
-        body_weights = (torch.cat([p.body_weights for p in pairs])
+        # Checked above: every pair has body weights when the head has the prior.
+        prior_logits = (torch.cat([body_prior_logits(p.body_weights, p.rest_pos,
+                                                     self.config.weight_reach) for p in pairs])
                         if self.weight_head.body_prior else None)
         return DeformerContext(fused=fused, rest_pos=torch.cat([p.rest_pos for p in pairs]),
                                ptr=_offsets(sizes), hierarchies=[p.hierarchy for p in pairs],
-                               body_weights=body_weights)
+                               prior_logits=prior_logits)
 
     # ---------------------------------------------------------------- per frame
     def forward(self, context: DeformerContext, motion_windows: torch.Tensor,
@@ -191,8 +193,8 @@ class GarmentDeformer(nn.Module):
         weights, processor_input = [], []
         for p in range(pairs):
             fused = context.fused[context.ptr[p]:context.ptr[p + 1]]           # (N, S, F)
-            prior = (None if context.body_weights is None else
-                     body_prior_logits(context.body_weights[context.ptr[p]:context.ptr[p + 1]]))
+            prior = (None if context.prior_logits is None else
+                     context.prior_logits[context.ptr[p]:context.ptr[p + 1]])
             weights.append(self.weight_head(fused, pose_code[p], prior).flatten(0, 1))  # Eq. 6
             processor_input.append(
                 (fused.flatten(1)[None] * velocity_code[p][:, None, :]).flatten(0, 1))  # Eq. 7

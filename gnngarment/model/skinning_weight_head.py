@@ -6,18 +6,30 @@ from __future__ import annotations
 import torch
 from torch import nn
 
+from gnngarment.body.joint_reach import reachable_joints
+
 #: Smallest body weight the prior's logarithm sees: joints the body gives no weight
 #: start at ``log(1e-6) ≈ −13.8``, far below, but still reachable by training.
 BODY_WEIGHT_FLOOR = 1e-6
 
 
-def body_prior_logits(body_weights: torch.Tensor) -> torch.Tensor:
+def body_prior_logits(body_weights: torch.Tensor, rest_pos: torch.Tensor | None = None,
+                      reach: float | None = None) -> torch.Tensor:
     """``log(max(W_body, 1e-6))``: logits whose softmax is the body weights (up to the
-    floor's renormalisation).
+    floor's renormalisation). With ``reach`` (metres), joints whose garment region lies
+    farther than that from a vertex (:func:`~gnngarment.body.joint_reach.reachable_joints`)
+    get ``-inf``: no correction the head learns can give them weight, so a trouser leg
+    never follows the neck however the motion moves it.
 
-    Shapes: ``(N, 24)`` → ``(N, 24)``.
+    Shapes: body_weights ``(N, 24)``, rest_pos ``(N, 3)`` (needed with ``reach``) →
+    ``(N, 24)``.
     """
-    return torch.log(body_weights.clamp_min(BODY_WEIGHT_FLOOR))
+    logits = torch.log(body_weights.clamp_min(BODY_WEIGHT_FLOOR))
+    if reach is None:
+        return logits
+    if rest_pos is None:
+        raise ValueError("a weight reach needs the garment's rest positions")
+    return logits.masked_fill(~reachable_joints(rest_pos, body_weights, reach), -torch.inf)
 
 
 class SkinningWeightHead(nn.Module):

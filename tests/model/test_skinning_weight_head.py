@@ -69,7 +69,7 @@ def test_no_prior_is_the_plain_softmax_head(garment) -> None:
     pair = make_pair(*garment, model.config)
     motion, velocity, transforms = frame_inputs(model.config, 1, 2)
     context = model.prepare([pair])
-    assert context.body_weights is None
+    assert context.prior_logits is None
     out = model(context, motion, velocity, transforms)
     pose_code, _ = model.pose_encoder(motion.flatten(0, 1))
     expected = torch.softmax(torch.einsum("nsf,bf->bns", context.fused, pose_code), -1)
@@ -160,3 +160,34 @@ def test_checkpoints_keep_their_prior(garment, tmp_path) -> None:
     reloaded = load_model(tmp_path / "new.pt")
     assert asdict(reloaded.config) == asdict(new.config)
     assert reloaded.weight_head.gate.item() == 0.25
+
+
+def test_weight_reach_gives_far_joints_no_weight(garment) -> None:
+    """However large the learned correction, a joint whose garment region is out of
+    reach gets exactly no weight; without a reach the same model gives it some."""
+    from gnngarment.body.joint_reach import reachable_joints
+
+    models = {reach: build(seed=4, weight_reach=reach) for reach in (None, 0.05)}
+    pair = make_pair(*garment, models[None].config)
+    inputs = frame_inputs(models[None].config, 1, 2)
+    reachable = reachable_joints(pair.rest_pos, pair.body_weights, 0.05)
+    assert 0 < reachable.sum() < reachable.numel()
+    far = ~reachable.repeat(2, 1)
+    for reach, model in models.items():
+        with torch.no_grad():
+            model.weight_head.gate.fill_(5.0)
+        weights = model(model.prepare([pair]), *inputs).weights
+        torch.testing.assert_close(weights.sum(-1), torch.ones(len(weights)))
+        if reach is None:
+            assert weights[far].max() > 1e-3
+        else:
+            assert weights[far].max() == 0
+
+
+@pytest.mark.parametrize("overrides,message", [
+    ({"weight_reach": 0.2, "weight_prior": "none"}, "weight_reach needs weight_prior"),
+    ({"weight_reach": -0.1}, "weight_reach must be positive"),
+])
+def test_bad_weight_reach_is_rejected(overrides, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        GarmentDeformer(tiny_config(**overrides))
