@@ -16,6 +16,7 @@ from gnngarment.inference.export import read_point_cache
 from gnngarment.paths import REPOSITORY_ROOT
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(1500)
 def test_quick_demo_end_to_end(tmp_path: Path, anny_body) -> None:
     configs = REPOSITORY_ROOT / "configs"

@@ -152,15 +152,12 @@ def test_feature_subset_and_body_features(anny_body):
     assert velocities[0].abs().max() == 0 and velocities[-1].norm(dim=-1).max() < 10.0
 
 
-def test_walk_speed(anny_body):
-    import time
-
+def test_a_four_second_walk_poses_every_frame(anny_body):
     walk = make_motion("walk", duration=4.0)
     anny_body.rest(ANNY_PRESETS["female"])
-    start = time.perf_counter()
     posed = anny_body.pose(walk, ANNY_PRESETS["female"])
     assert posed.vertices.shape == (121, 13348, 3)
-    assert time.perf_counter() - start < 20.0
+    assert torch.isfinite(posed.vertices).all()
 
 
 def test_skinning_weights_follow_the_posed_body(anny_body) -> None:

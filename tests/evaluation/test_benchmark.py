@@ -2,12 +2,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from gnngarment.evaluation.benchmark import run_benchmark
 from gnngarment.training.config import StageConfig, TrainingConfig
 from tests.model.pairs import tiny_config
 from tests.synthetic_cache import build_synthetic_cache
 
 
+@pytest.mark.slow
 def test_benchmark_trains_variants_and_writes_the_table(tmp_path: Path) -> None:
     cache = build_synthetic_cache(tmp_path / "cache", frames=4)
     config = TrainingConfig(data=str(cache), output=str(tmp_path / "runs"), model=tiny_config(),

@@ -14,6 +14,7 @@ from gnngarment.training.checkpoint import load_checkpoint
 from tests.synthetic_cache import build_synthetic_cache
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(600)
 def test_torchrun_with_two_processes_trains_and_checkpoints(tmp_path: Path) -> None:
     cache = build_synthetic_cache(tmp_path / "cache", frames=4)
