@@ -109,9 +109,9 @@ def pipeline_figure(body: BodyFrame, path: Path, seed: int = 4) -> None:
 
     from data_prep.garments import mesher
     from data_prep.garments.pattern import pair, silhouette, trace
-    from data_prep.garments.tshirt import TShirtStyle, tshirt_blueprint
+    from data_prep.garments.tshirt import TShirtStyle, tshirt_outline
 
-    design = tshirt_blueprint(body, TShirtStyle(sleeve_length=0.45, neckline="v",
+    design = tshirt_outline(body, TShirtStyle(sleeve_length=0.45, neckline="v",
                                                 neck_depth=0.1)).design
     outline = pair(trace(design, silhouette(design), -1), trace(design, silhouette(design), 1))
     panels, lifted, _ = mesher.build_panels(design, 1200, np.random.default_rng(seed))

@@ -5,8 +5,8 @@ from __future__ import annotations
 import dataclasses
 from typing import ClassVar
 
-from data_prep.garments.blueprint import Blueprint
 from data_prep.garments.body_frame import BodyFrame
+from data_prep.garments.outline import GarmentOutline
 from data_prep.garments.parts import bounds, hem_cut, hem_low, trunk_stack, upper_parts
 from data_prep.garments.shapes import Design
 from data_prep.garments.style import Style, choice, number
@@ -37,7 +37,7 @@ class DressStyle(Style):
     front_rise: float = number(0.0, -0.04, 0.1, "hem higher in front than at the back (m)")
 
 
-def dress_blueprint(body: BodyFrame, style: DressStyle) -> Blueprint:
+def dress_outline(body: BodyFrame, style: DressStyle) -> GarmentOutline:
     m = body.measurements
     z_hem = (m.z_crotch - 0.06) - style.length * (m.z_crotch - 0.06 - (m.z_ankle + 0.06))
     torso = trunk_stack(m, z_hem - 0.1, float(m.shoulder_z.max()) + 0.1, style.looseness,
@@ -52,4 +52,4 @@ def dress_blueprint(body: BodyFrame, style: DressStyle) -> Blueprint:
     design = Design(solids=solids, cuts=[hem, *cuts],
                     bounds=bounds(solids, hem_low(z_hem, style.front_rise),
                                   float(m.shoulder_z.max()) + 0.15))
-    return Blueprint(design=design, loops=loops + 1, top=top)
+    return GarmentOutline(design=design, loops=loops + 1, top=top)

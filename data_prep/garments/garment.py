@@ -14,27 +14,27 @@ from typing import Any
 
 import numpy as np
 
-from data_prep.garments.blueprint import Blueprint
 from data_prep.garments.body_frame import BodyFrame
-from data_prep.garments.dress import DressStyle, dress_blueprint
-from data_prep.garments.jumpsuit import JumpsuitStyle, jumpsuit_blueprint
+from data_prep.garments.dress import DressStyle, dress_outline
+from data_prep.garments.jumpsuit import JumpsuitStyle, jumpsuit_outline
 from data_prep.garments.mesher import mesh_design
+from data_prep.garments.outline import GarmentOutline
 from data_prep.garments.parts import CLEARANCE
 from data_prep.garments.pattern import PatternError
-from data_prep.garments.skirt import SkirtStyle, skirt_blueprint
+from data_prep.garments.skirt import SkirtStyle, skirt_outline
 from data_prep.garments.style import Style
-from data_prep.garments.top import TopStyle, top_blueprint
-from data_prep.garments.trousers import TrousersStyle, trousers_blueprint
-from data_prep.garments.tshirt import TShirtStyle, tshirt_blueprint
+from data_prep.garments.top import TopStyle, top_outline
+from data_prep.garments.trousers import TrousersStyle, trousers_outline
+from data_prep.garments.tshirt import TShirtStyle, tshirt_outline
 
-#: garment type → (style class, blueprint function)
-GARMENT_TYPES: dict[str, tuple[type[Style], Callable[[BodyFrame, Any], Blueprint]]] = {
-    "skirt": (SkirtStyle, skirt_blueprint),
-    "trousers": (TrousersStyle, trousers_blueprint),
-    "tshirt": (TShirtStyle, tshirt_blueprint),
-    "top": (TopStyle, top_blueprint),
-    "dress": (DressStyle, dress_blueprint),
-    "jumpsuit": (JumpsuitStyle, jumpsuit_blueprint),
+#: garment type → (style class, outline function)
+GARMENT_TYPES: dict[str, tuple[type[Style], Callable[[BodyFrame, Any], GarmentOutline]]] = {
+    "skirt": (SkirtStyle, skirt_outline),
+    "trousers": (TrousersStyle, trousers_outline),
+    "tshirt": (TShirtStyle, tshirt_outline),
+    "top": (TopStyle, top_outline),
+    "dress": (DressStyle, dress_outline),
+    "jumpsuit": (JumpsuitStyle, jumpsuit_outline),
 }
 
 #: Default range of target vertex counts drawn by the sampler (log-uniform).
@@ -102,34 +102,34 @@ def make_garment(body: BodyFrame, garment_type: str,
                          f"{sorted(GARMENT_TYPES)}")
     if not 300 <= int(target_vertices) <= MAX_VERTICES:
         raise ValueError(f"target_vertices must be in [300, {MAX_VERTICES}], got {target_vertices}")
-    style_class, blueprint_of = GARMENT_TYPES[garment_type]
+    style_class, outline_of = GARMENT_TYPES[garment_type]
     if not isinstance(style, style_class):
         style = style_class.from_dict(style)  # type: ignore[arg-type]
     try:
-        blueprint = blueprint_of(body, style)
+        outline = outline_of(body, style)
     except PatternError as error:
         raise GarmentError(f"{garment_type}: {error}") from error
     problems: list[str] = []
     for attempt in range(retries + 1):
         try:
-            mesh = mesh_design(blueprint.design, body.distance, int(target_vertices),
+            mesh = mesh_design(outline.design, body.distance, int(target_vertices),
                                np.random.default_rng(seed + attempt), clearance=CLEARANCE)
         except PatternError as error:
             problems = [str(error)]
             continue
-        if blueprint.top not in mesh.loops:
-            problems = [f"no {blueprint.top!r} opening (got {sorted(mesh.loops)})"]
+        if outline.top not in mesh.loops:
+            problems = [f"no {outline.top!r} opening (got {sorted(mesh.loops)})"]
             continue
         garment = Garment(
             name=name or f"{garment_type}_{seed}", garment_type=garment_type,
             style={**style.as_dict(), "target_vertices": int(target_vertices)},
-            pos=mesh.pos, faces=mesh.faces, pin_candidates=mesh.loops[blueprint.top],
+            pos=mesh.pos, faces=mesh.faces, pin_candidates=mesh.loops[outline.top],
             openings=mesh.loops)
         if not check:
             return garment
         from data_prep.garments.checks import garment_problems
 
-        problems = garment_problems(garment, body, expected_openings=blueprint.loops,
+        problems = garment_problems(garment, body, expected_openings=outline.loops,
                                     clearance=0.5 * CLEARANCE)
         if not problems:
             return garment

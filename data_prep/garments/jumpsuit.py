@@ -5,8 +5,8 @@ from __future__ import annotations
 import dataclasses
 from typing import ClassVar
 
-from data_prep.garments.blueprint import Blueprint
 from data_prep.garments.body_frame import BodyFrame
+from data_prep.garments.outline import GarmentOutline
 from data_prep.garments.parts import LEG_BLEND, bounds, hem_cut, trunk_stack, upper_parts
 from data_prep.garments.shapes import Design, Group
 from data_prep.garments.style import Style, choice, number
@@ -40,7 +40,7 @@ class JumpsuitStyle(Style):
     neck_width: float = number(0.02, 0.0, 0.05, "neckline width beyond the neck, each side (m)")
 
 
-def jumpsuit_blueprint(body: BodyFrame, style: JumpsuitStyle) -> Blueprint:
+def jumpsuit_outline(body: BodyFrame, style: JumpsuitStyle) -> GarmentOutline:
     m = body.measurements
     top_of_hem = m.z_crotch - 0.04
     z_hem = top_of_hem - style.length * (top_of_hem - (m.z_ankle + 0.03))
@@ -58,4 +58,4 @@ def jumpsuit_blueprint(body: BodyFrame, style: JumpsuitStyle) -> Blueprint:
     # so the blend never bridges the gap between them).
     design = Design(solids=solids, blend=0.07, cuts=[hem_cut(z_hem, legs[0], name="leg"), *cuts],
                     bounds=bounds(solids, z_hem, float(m.shoulder_z.max()) + 0.15))
-    return Blueprint(design=design, loops=loops + 2, top=top)
+    return GarmentOutline(design=design, loops=loops + 2, top=top)

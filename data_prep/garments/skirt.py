@@ -9,8 +9,8 @@ from typing import ClassVar
 import numpy as np
 from scipy.spatial import Delaunay
 
-from data_prep.garments.blueprint import Blueprint
 from data_prep.garments.body_frame import BodyFrame
+from data_prep.garments.outline import GarmentOutline
 from data_prep.garments.parts import bounds, hem_cut, hem_low, trunk_stack, waist_cut
 from data_prep.garments.shapes import Design
 from data_prep.garments.style import Style, number
@@ -80,7 +80,7 @@ class SkirtStyle(Style):
                                "back (m; high-low hem)")
 
 
-def skirt_blueprint(body: BodyFrame, style: SkirtStyle) -> Blueprint:
+def skirt_outline(body: BodyFrame, style: SkirtStyle) -> GarmentOutline:
     """The implicit skirt around ``body``: waist and hem cuts on a skirt stack."""
     m = body.measurements
     z_waist = m.z_hip + style.waist_height * (m.z_waist - m.z_hip)
@@ -92,4 +92,4 @@ def skirt_blueprint(body: BodyFrame, style: SkirtStyle) -> Blueprint:
     design = Design(solids=[stack],
                     cuts=[waist_cut(z_waist), hem_cut(z_hem, stack, front_rise=style.front_rise)],
                     bounds=bounds([stack], hem_low(z_hem, style.front_rise), z_waist + 0.03))
-    return Blueprint(design=design, loops=2, top="waist")
+    return GarmentOutline(design=design, loops=2, top="waist")

@@ -5,8 +5,8 @@ from __future__ import annotations
 import dataclasses
 from typing import ClassVar
 
-from data_prep.garments.blueprint import Blueprint
 from data_prep.garments.body_frame import BodyFrame
+from data_prep.garments.outline import GarmentOutline
 from data_prep.garments.parts import bounds, hem_cut, trunk_stack, upper_parts
 from data_prep.garments.shapes import Design
 from data_prep.garments.style import Style, choice, number
@@ -32,7 +32,7 @@ class TopStyle(Style):
     top_edge: float = number(0.04, 0.01, 0.1, "strapless: top edge below the armpits (m)")
 
 
-def top_blueprint(body: BodyFrame, style: TopStyle) -> Blueprint:
+def top_outline(body: BodyFrame, style: TopStyle) -> GarmentOutline:
     m = body.measurements
     z_hem = hem_height(body, style.length)
     torso = trunk_stack(m, z_hem - 0.1, float(m.shoulder_z.max()) + 0.1, style.looseness,
@@ -47,4 +47,4 @@ def top_blueprint(body: BodyFrame, style: TopStyle) -> Blueprint:
     solids = [torso, *extra]
     design = Design(solids=solids, cuts=[hem_cut(z_hem, torso), *cuts],
                     bounds=bounds(solids, z_hem - 0.03, float(m.shoulder_z.max()) + 0.15))
-    return Blueprint(design=design, loops=loops + 1, top=top)
+    return GarmentOutline(design=design, loops=loops + 1, top=top)

@@ -7,9 +7,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from data_prep.garments.blueprint import Blueprint
 from data_prep.garments.body_frame import BodyFrame
 from data_prep.garments.measurements import BodyMeasurements
+from data_prep.garments.outline import GarmentOutline
 from data_prep.garments.parts import LEG_BLEND, bounds, hem_cut, leg_stacks, trunk_stack, waist_cut
 from data_prep.garments.pattern import PatternError
 from data_prep.garments.shapes import Design, Group, Stack
@@ -67,7 +67,7 @@ def leg_parts(m: BodyMeasurements, hips: Stack, z_hem: float, leg_looseness: flo
     return legs, z_hem
 
 
-def trousers_blueprint(body: BodyFrame, style: TrousersStyle) -> Blueprint:
+def trousers_outline(body: BodyFrame, style: TrousersStyle) -> GarmentOutline:
     m = body.measurements
     z_waist = m.z_hip + style.waist_height * (m.z_waist - m.z_hip)
     top_of_hem = m.z_crotch - 0.04
@@ -82,4 +82,4 @@ def trousers_blueprint(body: BodyFrame, style: TrousersStyle) -> Blueprint:
     design = Design(solids=solids, blend=0.07,
                     cuts=[waist_cut(z_waist), hem_cut(z_hem, legs[0], name="leg")],
                     bounds=bounds(solids, z_hem, z_waist + 0.03))
-    return Blueprint(design=design, loops=3, top="waist")
+    return GarmentOutline(design=design, loops=3, top="waist")

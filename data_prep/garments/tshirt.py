@@ -5,8 +5,8 @@ from __future__ import annotations
 import dataclasses
 from typing import ClassVar
 
-from data_prep.garments.blueprint import Blueprint
 from data_prep.garments.body_frame import BodyFrame
+from data_prep.garments.outline import GarmentOutline
 from data_prep.garments.parts import bounds, hem_cut, hem_low, trunk_stack, upper_parts
 from data_prep.garments.shapes import Design
 from data_prep.garments.style import Style, choice, number
@@ -40,7 +40,7 @@ def hem_height(body: BodyFrame, length: float) -> float:
     return m.z_waist - length * (m.z_waist - (m.z_crotch - 0.12))
 
 
-def tshirt_blueprint(body: BodyFrame, style: TShirtStyle) -> Blueprint:
+def tshirt_outline(body: BodyFrame, style: TShirtStyle) -> GarmentOutline:
     m = body.measurements
     z_hem = hem_height(body, style.length)
     torso = trunk_stack(m, z_hem - 0.1, float(m.shoulder_z.max()) + 0.1, style.looseness,
@@ -56,4 +56,4 @@ def tshirt_blueprint(body: BodyFrame, style: TShirtStyle) -> Blueprint:
     design = Design(solids=solids, cuts=[hem, *cuts],
                     bounds=bounds(solids, hem_low(z_hem, style.front_rise),
                                   float(m.shoulder_z.max()) + 0.15))
-    return Blueprint(design=design, loops=loops + 1, top=top)
+    return GarmentOutline(design=design, loops=loops + 1, top=top)

@@ -8,7 +8,7 @@ from data_prep.garments.shapes import Design
 
 
 @dataclasses.dataclass
-class Blueprint:
+class GarmentOutline:
     """A garment type's output for one body and style.
 
     Attributes:
