@@ -318,7 +318,7 @@ def plot_profiles(path: Path, profiles: dict, names: list[str]) -> None:
     from matplotlib.figure import Figure
     from matplotlib.ticker import MaxNLocator
 
-    from gnngarment.geometry.files import atomic_write_bytes
+    from gnngarment.io.atomic import atomic_write_bytes
 
     garments_seen = sorted({key[0] for key in profiles})
     figure = Figure(figsize=(4.6 * len(garments_seen), 3.6))

@@ -37,7 +37,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from gnngarment.geometry.files import atomic_write_bytes  # noqa: E402
+from gnngarment.io.atomic import atomic_write_bytes  # noqa: E402
 
 PYTHON = sys.executable
 

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from data_prep.config import DataConfig
-from gnngarment.geometry.files import FolderLock, atomic_write_bytes
+from gnngarment.io.atomic import FolderLock, atomic_write_bytes
 
 #: Bumped when the builder's output changes for the same config (forces a rebuild).
 BUILDER_VERSION = 1

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from gnngarment.geometry.files import atomic_write_bytes
+from gnngarment.io.atomic import atomic_write_bytes
 
 #: A garment vertex is "on the body" within this median distance (metres).
 ALIGNMENT_TOLERANCE = 0.10

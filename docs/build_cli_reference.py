@@ -18,7 +18,7 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from gnngarment.cli import app  # noqa: E402
-from gnngarment.geometry.files import atomic_write_bytes  # noqa: E402
+from gnngarment.io.atomic import atomic_write_bytes  # noqa: E402
 
 INTRODUCTION = """\
 # Command-line reference

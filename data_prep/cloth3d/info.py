@@ -29,7 +29,7 @@ from typing import Any, BinaryIO
 import numpy as np
 
 from data_prep.cloth3d.errors import Cloth3DError
-from gnngarment.geometry.files import atomic_write
+from gnngarment.io.atomic import atomic_write
 
 #: Fields every CLOTH3D ``info.mat`` has and :func:`read_info` / :func:`write_info` need.
 REQUIRED_FIELDS = ("poses", "trans", "shape", "gender", "zrot", "outfit")

@@ -18,18 +18,18 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from data_prep.cloth3d.errors import Cloth3DError
+from data_prep.cloth3d.errors import Cloth3DError, point_cache_errors
 from data_prep.cloth3d.frames import to_world
 from data_prep.cloth3d.info import GENDER_NAMES, normalise_info, read_info, write_info
-from data_prep.cloth3d.obj_file import count_obj_vertices, write_obj
-from data_prep.cloth3d.point_cache import (
+from data_prep.cloth3d.rest_alignment import RestAlignment, rest_alignment
+from gnngarment.io import point_cache
+from gnngarment.io.obj import count_obj_vertices, write_obj
+from gnngarment.io.point_cache import (
     FLOAT16_MAX,
     PointCacheHeader,
     read_payload,
-    read_point_cache_header,
     write_point_cache,
 )
-from data_prep.cloth3d.rest_alignment import RestAlignment, rest_alignment
 
 INFO_FILE = "info.mat"
 #: Garment names in the CLOTH3D release (a folder may use any subset; others are allowed).
@@ -37,6 +37,29 @@ GARMENT_NAMES = ("Top", "Tshirt", "Trousers", "Skirt", "Jumpsuit", "Dress")
 #: Point cache extensions, in the order they are looked for.
 CACHE_EXTENSIONS = (".pc16", ".pc2")
 DEFAULT_FPS = 30.0  # not stored in CLOTH3D files; an assumption, configurable
+
+
+def read_point_cache_header(path: str | Path, half: bool | None = None) -> PointCacheHeader:
+    """:func:`gnngarment.io.point_cache.read_point_cache_header`, raising CLOTH3D's error.
+
+    Raises:
+        Cloth3DPointCacheError: as the library function (message ``<path>: <problem>``);
+            a :class:`Cloth3DError` and a ``PointCacheError``.
+    """
+    with point_cache_errors():
+        return point_cache.read_point_cache_header(path, half)
+
+
+def read_point_cache(path: str | Path, half: bool | None = None,
+                     frames: slice | None = None) -> np.ndarray:
+    """:func:`gnngarment.io.point_cache.read_point_cache`: ``(T, N, 3)`` float32
+    positions, raising CLOTH3D's error.
+
+    Raises:
+        Cloth3DPointCacheError: as the library function.
+    """
+    with point_cache_errors():
+        return point_cache.read_point_cache(path, half, frames)
 
 
 class Cloth3DGarment(NamedTuple):
@@ -244,7 +267,8 @@ def read_sequence(folder: str | Path, fps: float = DEFAULT_FPS) -> Cloth3DSequen
             raise Cloth3DError(f"{files.obj}: face indices span [{faces.min() + 1}, "
                                f"{faces.max() + 1}] (1-based) but there are {len(pos)} "
                                f"vertices")
-        frames = read_payload(files.header)
+        with point_cache_errors():
+            frames = read_payload(files.header)
         garments[name] = Cloth3DGarment(pos, faces, frames)
     return Cloth3DSequence(layout.folder.name, layout.folder, layout.info, float(fps), garments)
 

@@ -102,7 +102,7 @@ class Attribution:
 
     def save(self, path: str | Path) -> Path:
         """Write everything to one ``.npz`` (atomically)."""
-        from gnngarment.geometry.files import save_npz_atomic
+        from gnngarment.io.npz import save_npz_atomic
 
         path = Path(path)
         save_npz_atomic(path, {
@@ -120,7 +120,7 @@ class Attribution:
         Raises:
             ValueError: missing or corrupt file, or arrays absent (names the file).
         """
-        from gnngarment.geometry.files import load_npz
+        from gnngarment.io.npz import load_npz
 
         names = ("attributions", "target_vertices", "target", "output", "reduction", "value",
                  "baseline_value", "delta", "n_steps", "seconds")

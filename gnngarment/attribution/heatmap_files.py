@@ -20,7 +20,7 @@ from gnngarment.attribution.ply import write_attribution_ply
 from gnngarment.attribution.render import render_attribution
 from gnngarment.attribution.targets import geodesic_region, largest_output_vertex
 from gnngarment.data.body_inputs import BodyMotionInputs, BodyShapeInputs
-from gnngarment.geometry.files import atomic_write_bytes
+from gnngarment.io.atomic import atomic_write_bytes
 from gnngarment.model.deformer import GarmentDeformer
 
 

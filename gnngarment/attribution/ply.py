@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from gnngarment.attribution.colors import DEFAULT_COLORMAP, heat_colors, normalise_heat
-from gnngarment.geometry.files import atomic_write_bytes
+from gnngarment.io.atomic import atomic_write_bytes
 
 
 def write_attribution_ply(path: str | Path, pos: np.ndarray, faces: np.ndarray,

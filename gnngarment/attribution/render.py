@@ -14,8 +14,8 @@ from gnngarment.attribution.colors import (
     heat_colors,
     normalise_heat,
 )
-from gnngarment.geometry.files import atomic_write_bytes
 from gnngarment.geometry.normals import face_normals
+from gnngarment.io.atomic import atomic_write_bytes
 
 #: ``(elevation, azimuth)`` in degrees of the default views of a Z-up garment: front
 #: (camera on −Y, the body's front) and back.

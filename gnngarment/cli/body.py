@@ -18,8 +18,8 @@ def write_rest_body(out: Path, rest, faces: np.ndarray) -> None:
     import json
 
     from gnngarment.body.skeleton import JOINT_NAMES
-    from gnngarment.geometry.files import atomic_write_bytes
-    from gnngarment.inference.export.obj_sequence import write_obj
+    from gnngarment.io.atomic import atomic_write_bytes
+    from gnngarment.io.obj import write_obj
 
     write_obj(out / "rest_body.obj", rest.vertices.numpy(), np.asarray(faces),
               header="rest body (metres, Z up, facing -Y)")

@@ -21,8 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from gnngarment.geometry.files import atomic_write_bytes, load_npz, save_npz_atomic
 from gnngarment.geometry.hierarchy import PoolHierarchy
+from gnngarment.io.atomic import atomic_write_bytes
+from gnngarment.io.npz import load_npz, save_npz_atomic
 
 #: Bumped when the layout of any cache file changes: older caches are rebuilt.
 CACHE_FORMAT_VERSION = 2

@@ -12,7 +12,7 @@ import numpy as np
 
 from gnngarment.data.dataset import PreparedDataset
 from gnngarment.evaluation.evaluate import METRICS, BodyMeshes, evaluate
-from gnngarment.geometry.files import atomic_write_bytes
+from gnngarment.io.atomic import atomic_write_bytes
 from gnngarment.training.checkpoint import load_model
 from gnngarment.training.config import TrainingConfig
 from gnngarment.training.trainer import CHECKPOINT_NAME, SUPERVISED_CHECKPOINT_NAME, Trainer

@@ -289,7 +289,7 @@ def evaluate(models: dict[str, GarmentDeformer], dataset: PreparedDataset,
 def write_report(report: EvaluationReport, markdown: Path | None = None,
                  json_path: Path | None = None) -> None:
     """Write the report's Markdown table and/or JSON atomically."""
-    from gnngarment.geometry.files import atomic_write_bytes
+    from gnngarment.io.atomic import atomic_write_bytes
 
     if json_path is not None:
         atomic_write_bytes(json_path, report.to_json().encode())

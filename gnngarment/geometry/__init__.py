@@ -1,5 +1,6 @@
 """Garment mesh geometry: pure numpy/scipy (Warp, imported lazily, for queries against
-the body mesh), imports nothing else of gnngarment.
+the body mesh), imports nothing else of gnngarment but the file formats of
+:mod:`gnngarment.io` (numpy only).
 
 Public API (arrays in, arrays out; ``pos (N, 3)``, ``faces (F, 3)``, ``edge_index (2, E)``):
 """

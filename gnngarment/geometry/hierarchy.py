@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
-from gnngarment.geometry.files import load_npz, save_npz_atomic
 from gnngarment.geometry.pooling import pool
 from gnngarment.geometry.unpooling import unpooling_matrix
+from gnngarment.io.npz import load_npz, save_npz_atomic
 
 #: Bumped whenever the file layout or the algorithm changes, so stale caches rebuild.
 HIERARCHY_FORMAT_VERSION = 1

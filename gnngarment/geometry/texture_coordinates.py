@@ -6,7 +6,8 @@ triangle corner, an index into it, ``uv_faces (F, 3)`` (same triangle order as
 ``faces``). A vertex on a UV seam has several UVs, one per side, while its position is
 one; the vertex order and count stay the mesh's. ``uv`` follows the OBJ/Blender
 convention: origin at the bottom-left of the image, ``v`` up (glTF's ``v`` points down:
-``v_gltf = 1 − v``).
+``v_gltf = 1 − v``). The layout's check,
+:func:`~gnngarment.io.obj.check_texture_coordinates`, lives with the OBJ format.
 """
 
 from __future__ import annotations
@@ -15,23 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-
-def check_texture_coordinates(uv: np.ndarray, uv_faces: np.ndarray, num_faces: int) -> None:
-    """Raise a ``ValueError`` unless ``uv (K, 2)`` is finite and ``uv_faces (F, 3)``
-    holds integer indices into it for ``num_faces`` triangles."""
-    uv = np.asarray(uv)
-    uv_faces = np.asarray(uv_faces)
-    if uv.ndim != 2 or uv.shape[1] != 2 or len(uv) == 0:
-        raise ValueError(f"uv must be (K, 2) with K ≥ 1, got {uv.shape}")
-    if not np.issubdtype(uv.dtype, np.floating) or not np.isfinite(uv).all():
-        raise ValueError(f"uv must hold finite floats, got {uv.dtype}")
-    if uv_faces.shape != (num_faces, 3):
-        raise ValueError(f"uv_faces must be ({num_faces}, 3) like faces, got {uv_faces.shape}")
-    if not np.issubdtype(uv_faces.dtype, np.integer):
-        raise ValueError(f"uv_faces must hold integers, got {uv_faces.dtype}")
-    if num_faces and (uv_faces.min() < 0 or uv_faces.max() >= len(uv)):
-        raise ValueError(f"uv_faces indices span [{uv_faces.min()}, {uv_faces.max()}], "
-                         f"outside [0, {len(uv) - 1}]")
+from gnngarment.io.obj import check_texture_coordinates
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,8 @@
 """Animate a garment and export the result.
 
-Imports are lazy (PEP 562) so that light users such as ``data_prep.cloth3d``, which only
-needs the point-cache writer, do not pay for torch and torch-geometric.
+Imports are lazy (PEP 562) so that light users, such as a reader of exported point
+caches through :mod:`gnngarment.inference.export`, do not pay for torch and
+torch-geometric.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from gnngarment.geometry.files import FolderLock
+from gnngarment.io.atomic import FolderLock
 
 
 def check_output_folder(out: str | Path, what: str = "export") -> None:
@@ -17,7 +17,7 @@ def check_output_folder(out: str | Path, what: str = "export") -> None:
     folder or a lock file): the run makes the folder when it writes.
 
     Raises:
-        OSError: why not (:class:`~gnngarment.geometry.files.FolderBusyError` when
+        OSError: why not (:class:`~gnngarment.io.atomic.FolderBusyError` when
             another run holds the folder).
     """
     out = Path(out)

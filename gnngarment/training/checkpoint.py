@@ -14,7 +14,7 @@ import numpy as np
 import torch
 
 from gnngarment.config import merge_config
-from gnngarment.geometry.files import atomic_write
+from gnngarment.io.atomic import atomic_write
 from gnngarment.model.config import ModelConfig
 from gnngarment.model.deformer import GarmentDeformer
 

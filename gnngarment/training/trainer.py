@@ -15,7 +15,7 @@ import torch
 from torch import nn
 
 from gnngarment.data.dataset import PreparedDataset, TrainingBatch
-from gnngarment.geometry.files import atomic_write_bytes
+from gnngarment.io.atomic import atomic_write_bytes
 from gnngarment.model.deformer import DeformerOutput, GarmentDeformer
 from gnngarment.training.checkpoint import (
     load_checkpoint,

@@ -88,7 +88,7 @@ def test_bad_outputs(tmp_path, mesh_and_heat, call, message) -> None:
 
 
 def test_atomic_write_is_readable_and_keeps_the_mode(tmp_path) -> None:
-    from gnngarment.geometry.files import atomic_write_bytes
+    from gnngarment.io.atomic import atomic_write_bytes
 
     path = atomic_write_bytes(tmp_path / "sub" / "a.bin", b"one")
     assert path.read_bytes() == b"one" and path.stat().st_mode & 0o777 == 0o644

@@ -293,7 +293,7 @@ def test_a_second_run_into_a_busy_folder_is_refused_and_a_killed_one_leaves_noth
     import sys
     import time
 
-    from gnngarment.geometry.files import TEMP_SUFFIX
+    from gnngarment.io.atomic import TEMP_SUFFIX
     from gnngarment.paths import REPOSITORY_ROOT
 
     out = files["folder"] / "busy"

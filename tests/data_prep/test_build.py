@@ -31,7 +31,7 @@ from data_prep.config import DataConfig
 from gnngarment.config import load_config
 from gnngarment.data import PreparedDataset
 from gnngarment.data.cache import read_garment, read_sequence
-from gnngarment.geometry.files import TEMP_SUFFIX
+from gnngarment.io.atomic import TEMP_SUFFIX
 from gnngarment.paths import REPOSITORY_ROOT
 
 TINY = REPOSITORY_ROOT / "configs" / "data" / "tiny.yaml"
@@ -93,7 +93,7 @@ def test_recorded_failure_is_tied_to_its_inputs(tmp_path: Path) -> None:
 
 
 def test_a_truncated_sequence_is_rebuilt_not_counted_as_built(tmp_path: Path) -> None:
-    from gnngarment.geometry.files import save_npz_atomic
+    from gnngarment.io.npz import save_npz_atomic
 
     path = tmp_path / "sequences" / "skirt000_body00_walk00.npz"
     save_npz_atomic(path, {"positions": np.zeros((4, 50, 3), np.float32)})

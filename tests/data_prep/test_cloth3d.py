@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 import scipy.io
 
-import data_prep.cloth3d.point_cache as point_cache_module
 import data_prep.cloth3d.sequence as sequence_module
+import gnngarment.io.point_cache as point_cache_module
 from data_prep.cloth3d import (
     Cloth3DError,
     atomic_write,

@@ -24,7 +24,7 @@ from data_prep.build import _intact_npz, _lost, build_dataset, plan_dataset
 from data_prep.config import DataConfig
 from gnngarment.cli import app
 from gnngarment.config import ConfigError, merge_config
-from gnngarment.geometry.files import TEMP_SUFFIX
+from gnngarment.io.atomic import TEMP_SUFFIX
 from tests.data_prep.test_build import tiny_config
 
 HAVE_RAY = importlib.util.find_spec("ray") is not None

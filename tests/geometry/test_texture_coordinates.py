@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gnngarment.geometry.texture_coordinates import check_texture_coordinates, split_uv_seams
+from gnngarment.geometry.texture_coordinates import split_uv_seams
+from gnngarment.io.obj import check_texture_coordinates
 from tests.inference.animations import rest_garment, tube_uv
 
 # Two triangles sharing the edge 1–2, cut along it in UV space: each side has its own

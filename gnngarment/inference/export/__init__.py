@@ -3,16 +3,17 @@
 Public API (numpy in, files out; ``posed (T, N, 3)`` metres, Z up):
 
 - everything at once: :func:`export_animation` (folder layout in ``docs/export.md``)
-- OBJ: :func:`write_obj_sequence`, :func:`write_obj` (input vertex order kept)
+- OBJ: :func:`write_obj_sequence`, :func:`write_obj` (input vertex order kept; the
+  writer is :mod:`gnngarment.io.obj`'s)
 - point caches: :func:`write_point_cache`, :func:`read_point_cache`,
-  :func:`read_point_cache_header` (``.pc2`` float32, ``.pc16`` float16)
+  :func:`read_point_cache_header` (``.pc2`` float32, ``.pc16`` float16; from
+  :mod:`gnngarment.io.point_cache`)
 - glTF: :func:`write_glb` (skinned + morph targets), :func:`read_glb`,
   :func:`evaluate_mesh_node` (what a viewer shows, in numpy)
 - preview: :func:`render_preview` (GIF)
 
-Names are resolved on first use (PEP 562), so ``import
-gnngarment.inference.export.point_cache`` (as ``data_prep`` does) loads neither torch nor
-matplotlib.
+Names are resolved on first use (PEP 562), so the point-cache and OBJ names load only
+:mod:`gnngarment.io`: neither torch nor matplotlib.
 """
 
 from __future__ import annotations
@@ -24,10 +25,12 @@ _MODULES = {
     "DEFAULT_FORMATS": "export", "FORMATS": "export", "export_animation": "export",
     "GLTF_FROM_WORLD": "gltf", "GlbExport": "gltf", "write_glb": "gltf",
     "evaluate_mesh_node": "gltf_reader", "read_glb": "gltf_reader",
-    "write_obj": "obj_sequence", "write_obj_sequence": "obj_sequence",
-    "PointCacheError": "point_cache", "PointCacheHeader": "point_cache",
-    "read_point_cache": "point_cache", "read_point_cache_header": "point_cache",
-    "write_point_cache": "point_cache",
+    "write_obj": "gnngarment.io.obj", "write_obj_sequence": "obj_sequence",
+    "PointCacheError": "gnngarment.io.point_cache",
+    "PointCacheHeader": "gnngarment.io.point_cache",
+    "read_point_cache": "gnngarment.io.point_cache",
+    "read_point_cache_header": "gnngarment.io.point_cache",
+    "write_point_cache": "gnngarment.io.point_cache",
     "render_preview": "preview",
 }
 
@@ -38,7 +41,9 @@ def __getattr__(name: str) -> Any:
     module = _MODULES.get(name)
     if module is None:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"{__name__}.{module}"), name)
+    # A bare name is a module of this package; a dotted one is absolute (gnngarment.io).
+    value = getattr(importlib.import_module(module if "." in module else f"{__name__}.{module}"),
+                    name)
     globals()[name] = value
     return value
 

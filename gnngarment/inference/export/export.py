@@ -27,12 +27,13 @@ from numbers import Integral
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from gnngarment.geometry.files import FolderLock, atomic_write_bytes
 from gnngarment.inference.export.gltf import write_glb
-from gnngarment.inference.export.obj_sequence import frame_path, write_obj, write_obj_sequence
-from gnngarment.inference.export.point_cache import write_point_cache
+from gnngarment.inference.export.obj_sequence import frame_path, write_obj_sequence
 from gnngarment.inference.export.preview import render_preview
 from gnngarment.inference.export.validation import check_animation
+from gnngarment.io.atomic import FolderLock, atomic_write_bytes
+from gnngarment.io.obj import write_obj
+from gnngarment.io.point_cache import write_point_cache
 
 if TYPE_CHECKING:
     from gnngarment.inference.animate import Animation

@@ -37,7 +37,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from gnngarment.body.skeleton import JOINT_NAMES
-from gnngarment.geometry.files import atomic_write_bytes
 from gnngarment.geometry.normals import vertex_normals
 from gnngarment.geometry.texture_coordinates import SeamSplit, split_uv_seams
 from gnngarment.inference.export.gltf_reader import evaluate_mesh_node, read_glb
@@ -52,6 +51,7 @@ from gnngarment.inference.export.static_skin import (
     static_skin,
 )
 from gnngarment.inference.export.validation import check_animation
+from gnngarment.io.atomic import atomic_write_bytes
 
 if TYPE_CHECKING:
     from gnngarment.inference.animate import Animation

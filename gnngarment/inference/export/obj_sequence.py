@@ -7,6 +7,10 @@ No normals, groups or objects, so every importer reads the vertices back in file
 and a point cache or shape key made from one frame lines up with any other. Coordinates
 are the library's world frame: metres, **Z up**, the body facing −Y (import with "Up: Z,
 Forward: Y" in Blender to keep them).
+
+The lines are :mod:`gnngarment.io.obj`'s (the library's one OBJ writer: 9 significant
+digits per coordinate; a single OBJ is :func:`gnngarment.io.obj.write_obj`); this module
+names the frames' files and checks the whole sequence before writing any of them.
 """
 
 from __future__ import annotations
@@ -16,32 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from gnngarment.geometry.files import atomic_write_bytes
-from gnngarment.geometry.texture_coordinates import check_texture_coordinates
-
-#: Decimals written per coordinate: 1 µm, far below any garment detail.
-DECIMALS = 6
-
-
-def obj_text(pos: np.ndarray, faces: np.ndarray, header: str = "",
-             uv: np.ndarray | None = None, uv_faces: np.ndarray | None = None) -> str:
-    """The OBJ text of one mesh: optional ``# header`` lines, ``v`` lines in order, the
-    ``vt`` lines when ``uv`` is given, then ``f`` lines (1-based; ``f v/vt`` with UVs).
-
-    Shapes:
-        pos ``(N, 3)``, faces ``(F, 3)`` 0-based; uv ``(K, 2)`` (OBJ convention) and
-        uv_faces ``(F, 3)`` 0-based per-corner indices into it, or both ``None``.
-    """
-    comments = "".join(f"# {line}\n" for line in header.splitlines())
-    return (comments + _vertex_block(np.asarray(pos))
-            + _texture_and_face_block(np.asarray(faces), uv, uv_faces))
-
-
-def write_obj(path: str | Path, pos: np.ndarray, faces: np.ndarray, header: str = "",
-              uv: np.ndarray | None = None, uv_faces: np.ndarray | None = None) -> Path:
-    """Write one OBJ atomically (see :func:`obj_text`); the folder must exist."""
-    _check(np.asarray(pos)[None], np.asarray(faces), uv, uv_faces)
-    return atomic_write_bytes(path, obj_text(pos, faces, header, uv, uv_faces).encode("ascii"))
+from gnngarment.io.atomic import atomic_write_bytes
+from gnngarment.io.obj import check_texture_coordinates, face_lines, vertex_lines
 
 
 def frame_path(folder: str | Path, stem: str, number: int, digits: int = 4) -> Path:
@@ -80,31 +60,15 @@ def write_obj_sequence(folder: str | Path, frames: np.ndarray, faces: np.ndarray
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     digits = max(4, len(str(first_frame + len(frames) - 1)))
-    face_block = _texture_and_face_block(faces, uv, uv_faces)
+    face_block = face_lines(faces, uv, uv_faces)  # the same in every frame
     paths = []
     for t, frame in enumerate(frames):
         path = frame_path(folder, stem, first_frame + t, digits)
-        text = f"# {stem} frame {first_frame + t}\n" + _vertex_block(frame) + face_block
+        text = f"# {stem} frame {first_frame + t}\n" + vertex_lines(frame) + face_block
         paths.append(atomic_write_bytes(path, text.encode("ascii")))
         if progress is not None:
             progress(t + 1, len(frames))
     return paths
-
-
-def _vertex_block(pos: np.ndarray) -> str:
-    # One %-format over the whole frame is ~3× faster than numpy.savetxt.
-    line = f"v %.{DECIMALS}f %.{DECIMALS}f %.{DECIMALS}f\n"
-    return (line * len(pos)) % tuple(np.asarray(pos, dtype=np.float64).ravel().tolist())
-
-
-def _texture_and_face_block(faces: np.ndarray, uv: np.ndarray | None,
-                            uv_faces: np.ndarray | None) -> str:
-    if uv is None:
-        return ("f %d %d %d\n" * len(faces)) % tuple((np.asarray(faces) + 1).ravel().tolist())
-    texture = (f"vt %.{DECIMALS}f %.{DECIMALS}f\n" * len(uv)) % tuple(
-        np.asarray(uv, dtype=np.float64).ravel().tolist())
-    corners = np.stack([np.asarray(faces), np.asarray(uv_faces)], axis=-1) + 1  # (F, 3, 2)
-    return texture + ("f %d/%d %d/%d %d/%d\n" * len(faces)) % tuple(corners.ravel().tolist())
 
 
 def _check(frames: np.ndarray, faces: np.ndarray, uv: np.ndarray | None = None,

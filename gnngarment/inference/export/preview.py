@@ -17,9 +17,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gnngarment.geometry.files import atomic_write_bytes
 from gnngarment.geometry.normals import face_normals, vertex_normals
 from gnngarment.inference.export.validation import check_animation
+from gnngarment.io.atomic import atomic_write_bytes
 
 if TYPE_CHECKING:
     from gnngarment.inference.animate import Animation

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from gnngarment.body.skeleton import NUM_JOINTS
-from gnngarment.geometry.texture_coordinates import check_texture_coordinates
+from gnngarment.io.obj import check_texture_coordinates
 
 if TYPE_CHECKING:
     from gnngarment.inference.animate import Animation

@@ -1,5 +1,7 @@
-"""Atomic ``.npz`` files: written to a temporary file and renamed, read with errors
-that name the file. Shared by every cache of the library."""
+"""Atomic writes: a file is written to a hidden temporary beside it, fsynced and renamed
+over, so a reader sees the old file or the complete new one, never a truncated one; and
+:class:`FolderLock`, one run at a time per output folder. Caches, checkpoints, exports
+and reports are written through :func:`atomic_write`."""
 
 from __future__ import annotations
 
@@ -7,12 +9,9 @@ import contextlib
 import os
 import re
 import secrets
-import zipfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import BinaryIO
-
-import numpy as np
 
 #: Suffix of in-progress files; a crash can leave one behind, readers ignore them.
 TEMP_SUFFIX = ".tmp"
@@ -60,33 +59,6 @@ def atomic_write(path: str | Path, write: Callable[[BinaryIO], None]) -> Path:
 def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
     """Write ``data`` to ``path`` atomically (see :func:`atomic_write`)."""
     return atomic_write(path, lambda stream: stream.write(data))
-
-
-def save_npz_atomic(path: str | Path, arrays: dict[str, np.ndarray]) -> None:
-    """Write ``arrays`` to ``path`` so that readers see the old file or the complete
-    new one, never a truncated file."""
-    atomic_write(path, lambda stream: np.savez(stream, **arrays))
-
-
-def load_npz(path: str | Path, required: tuple[str, ...] = ()) -> dict[str, np.ndarray]:
-    """Read every array of an ``.npz`` into memory.
-
-    Raises:
-        ValueError: missing, truncated or corrupt file, or a ``required`` key absent;
-            the message names the file.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"{path}: file not found")
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            arrays = {key: data[key] for key in data.files}
-    except (OSError, EOFError, ValueError, KeyError, zipfile.BadZipFile) as error:
-        raise ValueError(f"{path}: truncated or corrupt file ({error})") from error
-    missing = [key for key in required if key not in arrays]
-    if missing:
-        raise ValueError(f"{path}: missing arrays {missing}")
-    return arrays
 
 
 #: The name of a temporary file :func:`atomic_write` makes: ``.<name>.<8 hex>.tmp``.

@@ -1,4 +1,4 @@
-"""Atomic writes and output-folder locks (gnngarment/geometry/files.py)."""
+"""Atomic writes and output-folder locks (gnngarment/io/atomic.py)."""
 
 from __future__ import annotations
 
@@ -8,14 +8,14 @@ from pathlib import Path
 
 import pytest
 
-from gnngarment.geometry.files import FolderBusyError, FolderLock, atomic_write_bytes
+from gnngarment.io.atomic import FolderBusyError, FolderLock, atomic_write_bytes
 
 
 def test_a_held_folder_refuses_a_second_run_even_from_another_process(tmp_path: Path) -> None:
     with FolderLock(tmp_path, "build"):
         with pytest.raises(FolderBusyError, match=r"another build \(pid \d+\)"):
             FolderLock(tmp_path, "build").__enter__()
-        code = ("import sys; from gnngarment.geometry.files import FolderLock, FolderBusyError\n"
+        code = ("import sys; from gnngarment.io.atomic import FolderLock, FolderBusyError\n"
                 "try:\n    FolderLock(sys.argv[1]).__enter__()\n"
                 "except FolderBusyError:\n    sys.exit(3)\n")
         assert subprocess.run([sys.executable, "-c", code, str(tmp_path)]).returncode == 3

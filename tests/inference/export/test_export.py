@@ -159,7 +159,7 @@ def test_a_shorter_rerun_leaves_no_frames_of_the_previous_export(animation,
 
 def test_a_second_export_into_a_busy_folder_is_refused_and_stale_temporaries_go(
         animation, tmp_path: Path) -> None:
-    from gnngarment.geometry.files import FolderBusyError, FolderLock
+    from gnngarment.io.atomic import FolderBusyError, FolderLock
 
     with FolderLock(tmp_path, "export"), pytest.raises(FolderBusyError, match="another export"):
         export_animation(animation, tmp_path, "skirt", formats=("pc2",))

@@ -1,4 +1,5 @@
-"""The library's PointCache2 reader/writer, and data_prep's re-export of it."""
+"""The library's PointCache2 reader/writer (gnngarment/io/point_cache.py), and data_prep's
+CLOTH3D-error view of it."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gnngarment.inference.export.point_cache import (
+from gnngarment.io.point_cache import (
     HEADER,
     PointCacheError,
     read_point_cache,

@@ -31,7 +31,7 @@ from typing import BinaryIO
 
 import numpy as np
 
-from gnngarment.geometry.files import atomic_write
+from gnngarment.io.atomic import atomic_write
 
 
 class PointCacheError(ValueError):

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from gnngarment.geometry.mesh_io import read_obj, read_textured_obj
-from gnngarment.inference.export.obj_sequence import write_obj, write_obj_sequence
+from gnngarment.inference.export.obj_sequence import write_obj_sequence
+from gnngarment.io.obj import write_obj
 from tests.inference.animations import rest_garment, tube_uv
 from tests.meshes import random_disk
 
@@ -38,14 +39,6 @@ def test_long_sequences_pad_to_sort_and_first_frame_is_configurable(tmp_path: Pa
     paths = write_obj_sequence(tmp_path, frames, np.array([[0, 1, 2]]), "body",
                                first_frame=9998)
     assert [p.name for p in paths] == ["body_09998.obj", "body_09999.obj", "body_10000.obj"]
-
-
-def test_single_obj_has_header_and_only_v_and_f_lines(tmp_path: Path) -> None:
-    path = write_obj(tmp_path / "rest.obj", np.eye(3), np.array([[0, 1, 2]]), header="a\nb")
-    lines = path.read_text().splitlines()
-    assert lines[:2] == ["# a", "# b"]
-    assert {line.split()[0] for line in lines[2:]} == {"v", "f"}
-    assert lines[-1] == "f 1 2 3"
 
 
 @pytest.mark.parametrize(("frames", "faces", "message"), [

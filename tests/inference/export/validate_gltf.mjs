@@ -1,5 +1,5 @@
 // Validate a glTF/GLB file with the Khronos glTF-Validator and print its report as JSON.
-// Usage: node tests/inference/validate_gltf.mjs FILE.glb
+// Usage: node tests/inference/export/validate_gltf.mjs FILE.glb
 // Needs the npm devDependency `gltf-validator` (run `npm ci` at the repository root).
 import { readFile } from "node:fs/promises";
 import validator from "gltf-validator";

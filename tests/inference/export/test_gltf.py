@@ -15,7 +15,7 @@ from gnngarment.inference.export.gltf import GLTF_FROM_WORLD, write_glb
 from gnngarment.inference.export.gltf_reader import evaluate_mesh_node, keyframe_times, read_glb
 from tests.inference.animations import synthetic_animation, tube_uv
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 VALIDATOR_SCRIPT = Path(__file__).with_name("validate_gltf.mjs")
 
 
