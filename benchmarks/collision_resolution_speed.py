@@ -38,8 +38,8 @@ from gnngarment.body import AnnyBodyModel, load_motion  # noqa: E402
 from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs  # noqa: E402
 from gnngarment.geometry.body_collisions import CollisionSettings, resolve_collisions  # noqa: E402
 from gnngarment.inference.animate import animate  # noqa: E402
+from gnngarment.model.checkpoint import load_model  # noqa: E402
 from gnngarment.paths import SHIPPED_MODEL  # noqa: E402
-from gnngarment.training.checkpoint import load_model  # noqa: E402
 
 #: name → (waist radius, hem radius) [m].
 SKIRTS = {"loose": (0.17, 0.30), "tight": (0.15, 0.20)}

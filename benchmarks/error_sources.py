@@ -31,7 +31,7 @@ if str(ROOT) not in sys.path:
 from gnngarment.body.skinning import skin  # noqa: E402
 from gnngarment.data import PreparedDataset  # noqa: E402
 from gnngarment.data.cache import read_garment  # noqa: E402
-from gnngarment.training.checkpoint import load_model  # noqa: E402
+from gnngarment.model.checkpoint import load_model  # noqa: E402
 from gnngarment.training.trainer import TrainingStep  # noqa: E402
 
 

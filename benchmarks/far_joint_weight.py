@@ -28,7 +28,7 @@ from data_prep.posed_bodies import synthetic_body_meshes, synthetic_skinning_wei
 from gnngarment.data import PreparedDataset  # noqa: E402
 from gnngarment.evaluation.evaluate import predict  # noqa: E402
 from gnngarment.evaluation.metrics import far_joint_weight  # noqa: E402
-from gnngarment.training.checkpoint import load_model  # noqa: E402
+from gnngarment.model.checkpoint import load_model  # noqa: E402
 
 
 def main() -> None:

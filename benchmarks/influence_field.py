@@ -53,10 +53,10 @@ from gnngarment.config import load_config
 from gnngarment.data.pair import GarmentBodyPair
 from gnngarment.geometry.hierarchy import PoolHierarchy, PoolLevel
 from gnngarment.geometry.prepare import GarmentPreparationConfig, prepare_garment
+from gnngarment.model.checkpoint import load_model
 from gnngarment.model.config import ModelConfig
 from gnngarment.model.deformer import GarmentDeformer
 from gnngarment.paths import default_config
-from gnngarment.training.checkpoint import load_model
 
 #: A T-pose skeleton (metres, Z up, facing −Y, pelvis at the origin) for the
 #: synthetic body: only the joint-distance features need it.

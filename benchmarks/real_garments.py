@@ -42,8 +42,8 @@ from gnngarment.geometry.mesh_io import load_mesh  # noqa: E402
 from gnngarment.inference.animate import animate  # noqa: E402
 from gnngarment.inference.checks import _Surface  # noqa: E402
 from gnngarment.inference.placement import place_garment  # noqa: E402
+from gnngarment.model.checkpoint import load_model  # noqa: E402
 from gnngarment.paths import SHIPPED_MODEL  # noqa: E402
-from gnngarment.training.checkpoint import load_model  # noqa: E402
 
 #: Garment → the body it was modelled on (../shared/real-world/README.md).
 SOURCE_BODIES = {

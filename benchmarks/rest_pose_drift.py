@@ -29,8 +29,8 @@ from gnngarment.body import AnnyBodyModel, AnnyShape, make_motion  # noqa: E402
 from gnngarment.body.procedural import HOLD_SECONDS  # noqa: E402
 from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs  # noqa: E402
 from gnngarment.inference.animate import animate  # noqa: E402
+from gnngarment.model.checkpoint import load_model  # noqa: E402
 from gnngarment.paths import SHIPPED_MODEL  # noqa: E402
-from gnngarment.training.checkpoint import load_model  # noqa: E402
 
 
 def main() -> None:

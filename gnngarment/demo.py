@@ -77,7 +77,7 @@ def run(out: Path, data_config: Path, train_config: Path, model_path: Path | Non
     from gnngarment.geometry import load_mesh
     from gnngarment.inference.animate import animate
     from gnngarment.inference.export import export_animation
-    from gnngarment.training.checkpoint import load_model
+    from gnngarment.model.checkpoint import load_model
     from gnngarment.training.loading import load_training_config
     from gnngarment.training.trainer import Trainer
 

@@ -78,7 +78,7 @@ def attribute_command(
     from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs
     from gnngarment.geometry.errors import MeshError
     from gnngarment.geometry.mesh_io import load_mesh
-    from gnngarment.training.checkpoint import load_model
+    from gnngarment.model.checkpoint import load_model
 
     console = Console(stderr=True)
     if target not in TARGET_KINDS:

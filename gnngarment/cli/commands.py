@@ -15,7 +15,12 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from gnngarment.cli.errors import check_motion_options, fail, refuse_misplaced_garment
+from gnngarment.cli.errors import (
+    check_motion_options,
+    check_output_file,
+    fail,
+    refuse_misplaced_garment,
+)
 from gnngarment.threads import use_idle_cores
 
 app = typer.Typer(help="Animate any garment mesh with one learned model.",
@@ -299,7 +304,7 @@ def train(
 
     from gnngarment.config import ConfigError
     from gnngarment.data import CacheError, PreparedDataset
-    from gnngarment.training.checkpoint import load_checkpoint
+    from gnngarment.model.checkpoint import load_checkpoint
     from gnngarment.training.loading import load_training_config
     from gnngarment.training.trainer import CHECKPOINT_NAME, RunFolderError, Trainer
 
@@ -354,10 +359,10 @@ def evaluate(
     from gnngarment.data import CacheError, PreparedDataset
     from gnngarment.evaluation import evaluate as run_evaluation
     from gnngarment.evaluation import write_report
-    from gnngarment.training.checkpoint import load_checkpoint, load_model
+    from gnngarment.model.checkpoint import load_checkpoint, load_model
 
     for option, path in (("--json", json_path), ("--markdown", markdown)):
-        _check_output_file(option, path)
+        check_output_file(option, path)
     use_idle_cores()
     try:
         model = load_model(checkpoint)
@@ -382,16 +387,6 @@ def evaluate(
     bar.close()
     console.print(report.to_markdown())
     write_report(report, markdown, json_path)
-
-
-def _check_output_file(option: str, path: Path | None) -> None:
-    """Before any work: ``path`` (if given) is not a folder and its folder exists."""
-    if path is None:
-        return
-    if path.is_dir():
-        raise fail(f"{option} {path}: is a folder; give a file name")
-    if not path.parent.is_dir():
-        raise fail(f"{option} {path}: the folder {path.parent} does not exist")
 
 
 def _collision_settings():
@@ -556,8 +551,8 @@ def animate(
     from gnngarment.inference.animate import animate as run_animation
     from gnngarment.inference.export import export_animation
     from gnngarment.inference.placement import place_garment
+    from gnngarment.model.checkpoint import load_model
     from gnngarment.paths import SHIPPED_MODEL
-    from gnngarment.training.checkpoint import load_model
 
     format_list = [f.strip() for f in formats.split(",")]
     _check_animate_options(fps, duration, motion_up_axis, format_list, fix_units, up_axis,
@@ -641,48 +636,12 @@ def animate(
         console.print(f"  {key}: {path}")
 
 
-@app.command("benchmark-accuracy")
-def benchmark_accuracy(
-    config: Annotated[Path, typer.Option(help="Training YAML shared by every variant.")],
-    output: Annotated[Path, typer.Option(help="Markdown table to write.")
-                      ] = Path("docs/results.md"),
-    variant: Annotated[list[str] | None, typer.Option(help="Only these variants.")] = None,
-    split: Annotated[str, typer.Option(help="Evaluated split.")] = "test",
-) -> None:
-    """Train ours and the pooling/single-level baselines with one budget, evaluate them
-    (and body-skinning LBS) before and after the physics stage, write the table."""
-    import sys
-
-    from gnngarment.config import ConfigError
-    from gnngarment.evaluation.benchmark import VARIANTS, run_benchmark
-    from gnngarment.training.loading import load_training_config
-
-    unknown = [v for v in variant or [] if v not in VARIANTS]
-    if unknown:
-        raise fail(f"unknown variant(s) {unknown}; choose from {list(VARIANTS)}")
-    _check_output_file("--output", output)  # written only after every variant is trained
-    try:
-        settings = load_training_config(config)
-    except (ConfigError, ValueError) as error:
-        raise fail(str(error)) from None
-    from data_prep.posed_bodies import synthetic_body_meshes, synthetic_skinning_weights
-    from gnngarment.data import CacheError
-
-    try:
-        body_meshes = synthetic_body_meshes(settings.data)
-        skinning_weights = synthetic_skinning_weights(settings.data)
-    except CacheError as error:
-        raise fail(str(error)) from None
-    result = run_benchmark(settings, output, variant, split,
-                           command="gnngarment " + " ".join(sys.argv[1:]),
-                           body_meshes=body_meshes, body_skinning_weights=skinning_weights)
-    console.print(f"[green]wrote[/] {output}: {len(result['rows'])} rows")
-
-
 def _register_commands() -> None:
     from gnngarment.cli.attribute import register as register_attribution
+    from gnngarment.cli.benchmark import register as register_benchmark
     from gnngarment.cli.body import register as register_body
 
+    register_benchmark(app)  # first: `--help` lists it after animate, as it always did
     register_body(app)
     register_attribution(app)
 

@@ -26,6 +26,20 @@ def fail(message: str) -> typer.Exit:
     return typer.Exit(BAD_INPUT)
 
 
+def check_output_file(option: str, path: Path | None) -> None:
+    """Before any work: ``path`` (if given) is not a folder and its folder exists.
+
+    Raises:
+        typer.Exit: (after the message) a folder, or a file in a missing folder.
+    """
+    if path is None:
+        return
+    if path.is_dir():
+        raise fail(f"{option} {path}: is a folder; give a file name")
+    if not path.parent.is_dir():
+        raise fail(f"{option} {path}: the folder {path.parent} does not exist")
+
+
 #: Up axes a motion file may be read with (``--motion-up-axis``).
 MOTION_UP_AXES = ("auto", "y", "z")
 

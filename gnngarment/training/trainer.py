@@ -16,16 +16,11 @@ from torch import nn
 
 from gnngarment.data.dataset import PreparedDataset, TrainingBatch
 from gnngarment.io.atomic import atomic_write_bytes
+from gnngarment.model.checkpoint import load_checkpoint, model_payload, save_checkpoint
 from gnngarment.model.deformer import DeformerOutput, GarmentDeformer
-from gnngarment.training.checkpoint import (
-    load_checkpoint,
-    model_payload,
-    rng_state,
-    save_checkpoint,
-    set_rng_state,
-)
 from gnngarment.training.config import TrainingConfig
 from gnngarment.training.objective import stage_loss
+from gnngarment.training.rng import rng_state, set_rng_state
 from gnngarment.training.schedule import StageSchedule
 
 CHECKPOINT_NAME = "last.pt"

@@ -11,7 +11,8 @@ import pytest
 import torch
 
 from gnngarment.attribution import Attribution, attribute
-from gnngarment.model import GarmentBodyPair, GarmentDeformer, ModelConfig
+from gnngarment.data.pair import GarmentBodyPair
+from gnngarment.model import GarmentDeformer, ModelConfig
 from tests.meshes import tube
 from tests.model.pairs import frame_inputs, make_pair, tiny_config
 

@@ -15,7 +15,7 @@ from gnngarment.cli import app
 from gnngarment.geometry import load_mesh
 from gnngarment.inference.export import read_point_cache
 from gnngarment.model import GarmentDeformer
-from gnngarment.training.checkpoint import model_payload, save_checkpoint
+from gnngarment.model.checkpoint import model_payload, save_checkpoint
 from tests.model.pairs import tiny_config
 
 runner = CliRunner()

@@ -96,7 +96,7 @@ def inputs(tmp_path_factory: pytest.TempPathFactory, anny_body) -> dict[str, Pat
     """The (read-only) hostile and good input files, made once."""
     from data_prep.garments.skirt import flared_skirt
     from gnngarment.model import GarmentDeformer
-    from gnngarment.training.checkpoint import model_payload, save_checkpoint
+    from gnngarment.model.checkpoint import model_payload, save_checkpoint
     from tests.synthetic_cache import build_synthetic_cache
 
     folder = tmp_path_factory.mktemp("inputs")

@@ -71,7 +71,7 @@ def test_evaluate_reports_resolved_and_raw_metrics(tmp_path: Path) -> None:
     import torch
 
     from gnngarment.model import GarmentDeformer
-    from gnngarment.training.checkpoint import model_payload, save_checkpoint
+    from gnngarment.model.checkpoint import model_payload, save_checkpoint
     from tests.model.pairs import tiny_config
     from tests.synthetic_cache import build_synthetic_cache
 
@@ -122,7 +122,7 @@ def train_config(folder: Path, cache: Path, **values) -> Path:
 
 def test_train_refuses_what_it_cannot_do_as_asked(tiny_cache: Path, tmp_path: Path) -> None:
     from gnngarment.model import GarmentDeformer
-    from gnngarment.training.checkpoint import model_payload, save_checkpoint
+    from gnngarment.model.checkpoint import model_payload, save_checkpoint
     from tests.model.pairs import tiny_config
 
     run = tmp_path / "run"
@@ -179,7 +179,7 @@ def test_evaluate_refuses_a_mismatched_checkpoint_and_unusable_outputs_up_front(
     import torch
 
     from gnngarment.model import GarmentDeformer
-    from gnngarment.training.checkpoint import model_payload, save_checkpoint
+    from gnngarment.model.checkpoint import model_payload, save_checkpoint
     from tests.model.pairs import tiny_config
 
     torch.manual_seed(0)

@@ -5,8 +5,10 @@ from __future__ import annotations
 import numpy as np
 import torch
 
+from gnngarment.data.pair import GarmentBodyPair
+from gnngarment.data.vertex_features import garment_vertex_features
 from gnngarment.geometry import GarmentPreparationConfig, prepare_garment
-from gnngarment.model import GarmentBodyPair, ModelConfig, garment_vertex_features
+from gnngarment.model import ModelConfig
 
 
 def tiny_config(**overrides) -> ModelConfig:

@@ -9,12 +9,12 @@ import torch
 
 from gnngarment.body.skinning import skin
 from gnngarment.model import GarmentDeformer
+from gnngarment.model.checkpoint import load_model, model_payload, save_checkpoint
 from gnngarment.model.skinning_weight_head import (
     BODY_WEIGHT_FLOOR,
     SkinningWeightHead,
     body_prior_logits,
 )
-from gnngarment.training.checkpoint import load_model, model_payload, save_checkpoint
 from tests.meshes import random_disk, tube
 from tests.model.pairs import frame_inputs, make_pair, tiny_config
 

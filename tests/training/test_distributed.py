@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 import torch
 
-from gnngarment.training.checkpoint import load_checkpoint
+from gnngarment.model.checkpoint import load_checkpoint
 from tests.synthetic_cache import build_synthetic_cache
 
 

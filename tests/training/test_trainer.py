@@ -9,7 +9,7 @@ import pytest
 import torch
 
 from gnngarment.data import PreparedDataset
-from gnngarment.training.checkpoint import load_checkpoint, load_model, release_checkpoint
+from gnngarment.model.checkpoint import load_checkpoint, load_model, release_checkpoint
 from gnngarment.training.config import StageConfig, TrainingConfig
 from gnngarment.training.trainer import RunFolderError, Trainer, TrainingStep
 from tests.model.pairs import tiny_config

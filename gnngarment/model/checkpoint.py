@@ -1,10 +1,12 @@
-"""Checkpoints: written atomically with a content hash, loaded with ``weights_only=True``
-and checked against the hash."""
+"""The checkpoint format and model loading: written atomically with a content hash,
+loaded with ``weights_only=True`` and checked against the hash; a model rebuilt from one.
+
+What a checkpoint carries only to resume a training run (optimiser, scheduler and RNG
+states) is written and read by the trainer."""
 
 from __future__ import annotations
 
 import hashlib
-import random
 import re
 from dataclasses import asdict
 from pathlib import Path
@@ -188,21 +190,3 @@ def release_checkpoint(source: str | Path, destination: str | Path) -> Path:
     payload = load_checkpoint(source)
     save_checkpoint(destination, {k: payload[k] for k in RELEASE_KEYS if k in payload})
     return Path(destination)
-
-
-def rng_state() -> dict[str, Any]:
-    """torch, numpy-global and python RNG states as plain tensors/lists (safe to load
-    with ``weights_only``)."""
-    numpy_state = np.random.get_state()
-    return {"torch": torch.get_rng_state(),
-            "numpy": [numpy_state[0], torch.from_numpy(numpy_state[1].astype(np.int64)),
-                      *numpy_state[2:]],
-            "python": [random.getstate()[0], list(random.getstate()[1]), random.getstate()[2]]}
-
-
-def set_rng_state(state: dict[str, Any]) -> None:
-    torch.set_rng_state(state["torch"])
-    kind, keys, position, has_gauss, cached = state["numpy"]
-    np.random.set_state((kind, keys.numpy().astype(np.uint32), position, has_gauss, cached))
-    version, internal, gauss = state["python"]
-    random.setstate((version, tuple(internal), gauss))

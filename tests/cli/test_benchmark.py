@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from gnngarment.evaluation.benchmark import run_benchmark
+from gnngarment.cli.benchmark import run_benchmark
 from gnngarment.training.config import StageConfig, TrainingConfig
 from tests.model.pairs import tiny_config
 from tests.synthetic_cache import build_synthetic_cache

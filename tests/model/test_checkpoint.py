@@ -9,7 +9,7 @@ import pytest
 import torch
 
 from gnngarment.model import GarmentDeformer
-from gnngarment.training.checkpoint import (
+from gnngarment.model.checkpoint import (
     CHECKPOINT_FORMAT_VERSION,
     load_checkpoint,
     load_model,

@@ -1,19 +1,24 @@
 """``gnngarment benchmark-accuracy``: train and evaluate ours and the baselines on the same
-data with the same budget, and write the comparison table (docs/results.md)."""
+data with the same budget, and write the comparison table (docs/results.md).
+
+An experiment runner, not a metric: it drives the trainer, so it lives beside the CLI
+(which may import everything) rather than in :mod:`gnngarment.evaluation`."""
 
 from __future__ import annotations
 
 import time
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
+import typer
 
+from gnngarment.cli.errors import check_output_file, fail
 from gnngarment.data.dataset import PreparedDataset
 from gnngarment.evaluation.evaluate import METRICS, BodyMeshes, evaluate
 from gnngarment.io.atomic import atomic_write_bytes
-from gnngarment.training.checkpoint import load_model
+from gnngarment.model.checkpoint import load_model
 from gnngarment.training.config import TrainingConfig
 from gnngarment.training.trainer import CHECKPOINT_NAME, SUPERVISED_CHECKPOINT_NAME, Trainer
 
@@ -87,3 +92,46 @@ def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | No
         f"{k} {v:.0f}" for k, v in seconds.items())]
     atomic_write_bytes(output, ("\n".join(lines) + "\n").encode())
     return {"rows": rows, "seconds": seconds}
+
+
+def benchmark_command(
+    config: Annotated[Path, typer.Option(help="Training YAML shared by every variant.")],
+    output: Annotated[Path, typer.Option(help="Markdown table to write.")
+                      ] = Path("docs/results.md"),
+    variant: Annotated[list[str] | None, typer.Option(help="Only these variants.")] = None,
+    split: Annotated[str, typer.Option(help="Evaluated split.")] = "test",
+) -> None:
+    """Train ours and the pooling/single-level baselines with one budget, evaluate them
+    (and body-skinning LBS) before and after the physics stage, write the table."""
+    import sys
+
+    from rich.console import Console
+
+    from gnngarment.config import ConfigError
+    from gnngarment.training.loading import load_training_config
+
+    unknown = [v for v in variant or [] if v not in VARIANTS]
+    if unknown:
+        raise fail(f"unknown variant(s) {unknown}; choose from {list(VARIANTS)}")
+    check_output_file("--output", output)  # written only after every variant is trained
+    try:
+        settings = load_training_config(config)
+    except (ConfigError, ValueError) as error:
+        raise fail(str(error)) from None
+    from data_prep.posed_bodies import synthetic_body_meshes, synthetic_skinning_weights
+    from gnngarment.data import CacheError
+
+    try:
+        body_meshes = synthetic_body_meshes(settings.data)
+        skinning_weights = synthetic_skinning_weights(settings.data)
+    except CacheError as error:
+        raise fail(str(error)) from None
+    result = run_benchmark(settings, output, variant, split,
+                           command="gnngarment " + " ".join(sys.argv[1:]),
+                           body_meshes=body_meshes, body_skinning_weights=skinning_weights)
+    Console().print(f"[green]wrote[/] {output}: {len(result['rows'])} rows")
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``benchmark-accuracy`` to ``app``."""
+    app.command("benchmark-accuracy")(benchmark_command)
