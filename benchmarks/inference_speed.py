@@ -15,6 +15,16 @@ implementations (``csr``: GraphAttention, ``pyg``: GATConv), with:
   vertices against float32 (max / mean, mm) and M^mp's relative error on unit-normal
   inputs. ``small`` uses the shipped trained checkpoint (``models/gnngarment-small.pt``,
   same network), ``paper`` freshly initialised weights;
+* with ``--compile on``: ``torch.compile`` (inductor's CPU backend) of the csr model, per
+  ``--compile-target`` (``model``: the whole per-frame forward; ``processors``: the two
+  M^mp submodules; ``layers``: every GAT layer of them) and ``--compile-mode``, each
+  variant in a child process of its own, timed interleaved with that child's eager csr
+  runs: the first call (compile + run), frames/s, the ratio to eager and the max
+  posed-vertex difference;
+* with ``--onnx``: whether the supervised M^mp submodule exports to ONNX (both
+  exporters; the reason when not) and, when ``onnxruntime`` is installed, its MatMul
+  against torch's on M^mp's two largest dense projections, and a variant of the csr
+  model whose M^mp projections run on onnxruntime (timed like the compiled ones);
 * the Newton simulator's frames/s on the same skirt around a moving capsule, and the
   model ÷ simulator ratio.
 
@@ -22,6 +32,8 @@ implementations (``csr``: GraphAttention, ``pyg``: GATConv), with:
         [--batches 1 16] [--attention csr pyg] [--malloc both] [--repeats 5]
         [--threads 1 2 auto]
         [--no-bf16] [--no-simulator] [--sim-frames 30]
+        [--compile on] [--compile-target model processors layers]
+        [--compile-mode default max-autotune-no-cudagraphs] [--compile-cache cold] [--onnx]
 
 Timings are the best of ``--repeats`` runs after a warm-up run (the warm-up builds the
 cached graph structures): other processes share this machine's two cores.
@@ -36,6 +48,7 @@ import os
 import resource
 import subprocess
 import sys
+import tempfile
 import time
 from collections import defaultdict
 from collections.abc import Callable, Iterator
@@ -52,14 +65,10 @@ if str(ROOT) not in sys.path:
 
 from data_prep.garments.skirt import flared_skirt  # noqa: E402
 from gnngarment.config import load_config  # noqa: E402
+from gnngarment.data.pair import GarmentBodyPair  # noqa: E402
+from gnngarment.data.vertex_features import garment_vertex_features  # noqa: E402
 from gnngarment.geometry import GarmentPreparationConfig, prepare_garment  # noqa: E402
-from gnngarment.model import (  # noqa: E402
-    GarmentBodyPair,
-    GarmentDeformer,
-    ModelConfig,
-    garment_vertex_features,
-    stack_hierarchies,
-)
+from gnngarment.model import GarmentDeformer, ModelConfig, stack_hierarchies  # noqa: E402
 from gnngarment.model import deformer as deformer_module  # noqa: E402
 from gnngarment.model.graph_attention import set_attention  # noqa: E402
 
@@ -226,13 +235,191 @@ def processor_bf16_error(model: GarmentDeformer, pair: GarmentBodyPair, frames: 
     return float((low - reference).abs().max() / reference.abs().max())
 
 
+#: What ``--compile-target`` compiles (``nn.Module.compile``: in place, same weights).
+COMPILE_TARGETS = ("model", "processors", "layers")
+
+
+def compiled_model(base: GarmentDeformer, target: str, mode: str) -> GarmentDeformer:
+    """A copy of ``base`` (csr attention, no timing hooks) with ``target`` compiled by
+    inductor in ``mode``; compilation happens on the first call of each input shape.
+
+    The per-frame path has graph breaks that no compiler setting removes: the LSTMs
+    (dynamo does not trace RNNs), the data-dependent softmax-shift choice
+    (``float(aminmax)`` in ``_softmax_shift``), the ``warnings`` filter around each CSR
+    tensor, and the ragged skinning's ``repeat_interleave``/``item``; ``model`` compiles
+    the pieces in between.
+    """
+    model = set_attention(copy.deepcopy(base), "csr")
+    options = {"backend": "inductor", "mode": None if mode == "default" else mode}
+    if target == "model":
+        model.compile(**options)
+    elif target == "processors":
+        for name in ("supervised_processor", "physics_processor"):
+            if getattr(model, name) is not None:
+                getattr(model, name).compile(**options)
+    elif target == "layers":
+        from gnngarment.model.graph_attention import GraphAttention
+
+        for name in ("supervised_processor", "physics_processor"):
+            module = getattr(model, name)
+            for layer in (module.modules() if module is not None else ()):
+                if isinstance(layer, GraphAttention):
+                    layer.compile(**options)
+    else:
+        raise ValueError(f"unknown compile target '{target}'")
+    return model
+
+
+class OnnxRuntimeLinear(torch.nn.Module):
+    """A bias-free ``nn.Linear`` evaluated by an onnxruntime ``MatMul`` session (as many
+    intra-op threads as torch has): the dense projections of M^mp on MLAS instead of
+    torch's BLAS, the rest eager."""
+
+    def __init__(self, linear: torch.nn.Linear):
+        super().__init__()
+        import onnxruntime
+        from onnx import TensorProto, helper, numpy_helper
+
+        self.weight = linear.weight  # GraphAttention._scores reads it
+        weight = linear.weight.detach().t().contiguous().numpy()
+        k, m = weight.shape
+        graph = helper.make_graph(
+            [helper.make_node("MatMul", ["x", "w"], ["y"])], "linear",
+            [helper.make_tensor_value_info("x", TensorProto.FLOAT, ["n", k])],
+            [helper.make_tensor_value_info("y", TensorProto.FLOAT, ["n", m])],
+            [numpy_helper.from_array(weight, "w")])
+        options = onnxruntime.SessionOptions()
+        options.intra_op_num_threads = torch.get_num_threads()
+        options.inter_op_num_threads = 1
+        self.session = onnxruntime.InferenceSession(
+            helper.make_model(graph, opset_imports=[helper.make_opsetid("", 18)])
+            .SerializeToString(), options, providers=["CPUExecutionProvider"])
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return torch.from_numpy(self.session.run(None, {"x": x.contiguous().numpy()})[0])
+
+
+def onnxruntime_model(base: GarmentDeformer) -> GarmentDeformer:
+    """A copy of ``base`` (csr) whose M^mp GAT projections run on onnxruntime."""
+    from gnngarment.model.graph_attention import GraphAttention
+
+    model = set_attention(copy.deepcopy(base), "csr")
+    for name in ("supervised_processor", "physics_processor"):
+        module = getattr(model, name)
+        for layer in (module.modules() if module is not None else ()):
+            if isinstance(layer, GraphAttention):
+                layer.lin = OnnxRuntimeLinear(layer.lin)
+    return model
+
+
+def allow_recompiles(limit: int = 256) -> None:
+    """Raise dynamo's per-function recompile limit (default 8): the GAT code runs at 3
+    levels × every batch size, and past the limit dynamo silently falls back to eager."""
+    import torch._dynamo
+
+    for name in ("recompile_limit", "cache_size_limit", "accumulated_recompile_limit",
+                 "accumulated_cache_size_limit"):
+        if hasattr(torch._dynamo.config, name):
+            setattr(torch._dynamo.config, name, max(limit, getattr(torch._dynamo.config, name)))
+
+
+def dynamo_counts() -> tuple[int, int]:
+    """(graphs compiled, graph breaks) so far in this process (dynamo's counters)."""
+    from torch._dynamo.utils import counters
+
+    return (int(counters["stats"].get("unique_graphs", 0)),
+            int(sum(counters["graph_break"].values())))
+
+
+def onnx_check(model: GarmentDeformer, pair: GarmentBodyPair, frames: int) -> dict:
+    """Try both ONNX exporters on the supervised M^mp submodule (``frames`` copies of
+    the garment); when ``onnxruntime`` is installed, time its MatMul (as many intra-op
+    threads as torch) against torch on M^mp's two largest dense projections
+    (the embedding GAT's ``(V, 24 F) @ (24 F, H C)`` and a level-0 GAT's
+    ``(V, C) @ (C, H C)``, trained weights, ``V`` = frames × vertices), interleaved,
+    median of 8."""
+    import io
+    import warnings
+
+    result: dict = {"frames": frames, "export": {}}
+    config = model.config
+    graph = stack_hierarchies([pair.hierarchy] * frames, config.levels)
+    processor = model.supervised_processor
+
+    class Processor(torch.nn.Module):
+        def __init__(self) -> None:
+            super().__init__()
+            self.processor = processor
+
+        def forward(self, x: torch.Tensor) -> torch.Tensor:
+            return self.processor(x, graph)
+
+    x = torch.randn(frames * pair.rest_pos.shape[0], config.feature_channels * 24)
+    processor(x, graph)  # builds the cached attention structures, as the first frame does
+    for exporter, dynamo in (("torch.export (dynamo=True)", True),
+                             ("TorchScript (dynamo=False)", False)):
+        tic = time.perf_counter()
+        try:
+            with warnings.catch_warnings(), torch.no_grad():
+                warnings.simplefilter("ignore")
+                torch.onnx.export(Processor().eval(), (x,), io.BytesIO(), dynamo=dynamo)
+            outcome = "exported"
+        except Exception as error:  # any failure: its reason is the result
+            cause = error
+            while cause.__cause__ is not None:  # the exporter wraps the tracer's error
+                cause = cause.__cause__
+            outcome = f"failed: {type(cause).__name__}: {str(cause).strip().splitlines()[0][:200]}"
+        result["export"][exporter] = {"outcome": outcome, "s": time.perf_counter() - tic}
+    try:
+        import onnxruntime
+        from onnx import TensorProto, helper, numpy_helper
+    except ImportError as error:
+        result["matmul"] = f"not measured ({error})"
+        return result
+    options = onnxruntime.SessionOptions()
+    options.intra_op_num_threads = torch.get_num_threads()
+    options.inter_op_num_threads = 1
+    result["onnxruntime"] = onnxruntime.__version__
+    result["matmul"] = {}
+    rows = frames * pair.rest_pos.shape[0]
+    for name, layer in (("embedding", processor.embedding), ("level-0 encoder", None)):
+        layer = layer if layer is not None else processor.decoders[0]
+        weight = layer.lin.weight.detach().t().contiguous()
+        k, m = weight.shape
+        onnx_graph = helper.make_graph(
+            [helper.make_node("MatMul", ["x", "w"], ["y"])], "matmul",
+            [helper.make_tensor_value_info("x", TensorProto.FLOAT, ["n", k])],
+            [helper.make_tensor_value_info("y", TensorProto.FLOAT, ["n", m])],
+            [numpy_helper.from_array(weight.numpy(), "w")])
+        session = onnxruntime.InferenceSession(
+            helper.make_model(onnx_graph, opset_imports=[helper.make_opsetid("", 18)])
+            .SerializeToString(), options, providers=["CPUExecutionProvider"])
+        dense = torch.randn(rows, k)
+        feed = {"x": dense.numpy()}
+        ours = session.run(None, feed)[0]
+        reference = layer.lin(dense)
+        times: dict[str, list[float]] = {"torch": [], "onnxruntime": []}
+        for _ in range(8):
+            tic = time.perf_counter()
+            layer.lin(dense)
+            times["torch"].append(time.perf_counter() - tic)
+            tic = time.perf_counter()
+            session.run(None, feed)
+            times["onnxruntime"].append(time.perf_counter() - tic)
+        result["matmul"][f"{name} ({rows}, {k}) @ ({k}, {m})"] = {
+            **{key: float(np.median(value)) for key, value in times.items()},
+            "max_rel": float((torch.from_numpy(ours) - reference).abs().max()
+                             / reference.abs().max())}
+    return result
+
+
 def initial_model(config: ModelConfig, args: argparse.Namespace
                   ) -> tuple[GarmentDeformer, str]:
     """The trained checkpoint when its network is this config's (realistic activations
     and blend shapes for the bf16 error), else freshly initialised weights (seed 0)."""
     path = Path(args.checkpoint) if args.checkpoint else None
     if path is not None and path.is_file():
-        from gnngarment.training.checkpoint import load_model
+        from gnngarment.model.checkpoint import load_model
 
         model = load_model(path)
         ours, theirs = asdict(model.config), asdict(config)
@@ -275,11 +462,39 @@ def child(args: argparse.Namespace) -> None:
                              "threads": threads, "weights": weights,
                              "prepare_s": time.perf_counter() - tic,
                              "rss_after_prepare_mb": peak_rss_mb(), "batches": {}}
+        compiled: dict[str, GarmentDeformer] = {}
+        if args.compile == "on" and "csr" in models:
+            allow_recompiles()
+            for target in args.compile_target:
+                for mode in args.compile_mode:
+                    compiled[f"{target}/{mode}"] = compiled_model(base, target, mode)
+        if args.onnx and "csr" in models:
+            try:
+                compiled["onnxruntime MatMul in M^mp"] = onnxruntime_model(base)
+            except ImportError as error:
+                print(f"onnxruntime variant not measured ({error})", file=sys.stderr)
         for frames in args.batches:
             inputs = frame_inputs(config, frames)
             runs: dict[str, Callable[[], torch.Tensor]] = {
                 impl: (lambda m=models[impl], c=contexts[impl], i=inputs: m(c, *i).posed)
                 for impl in args.impl}
+            first_calls: dict[str, dict] = {}
+            if compiled:
+                # The batch's graph structures (scipy, numpy) are built by an eager call:
+                # traced by dynamo inside the whole forward, that first call fails (torch
+                # 2.13: "Guard failed on the same frame it was created" on a from_numpy).
+                models["csr"](contexts["csr"], *inputs)
+            for name, model in compiled.items():
+                # The first call of this shape compiles (or recompiles) and runs once; the
+                # csr context is shared (same weights, same cached graph structures).
+                graphs, breaks = dynamo_counts()
+                tic = time.perf_counter()
+                model(contexts["csr"], *inputs)
+                after = dynamo_counts()
+                first_calls[name] = {"first_call_s": time.perf_counter() - tic,
+                                     "graphs": after[0] - graphs, "breaks": after[1] - breaks}
+                runs["compiled " + name] = (
+                    lambda m=model, c=contexts["csr"], i=inputs: m(c, *i).posed)
             if args.bf16 and "csr" in models:
                 model, context = models["csr"], contexts["csr"]
 
@@ -299,6 +514,14 @@ def child(args: argparse.Namespace) -> None:
                     entry["max_diff_vs_" + args.impl[0]] = float(
                         (timed[impl]["out"] - timed[args.impl[0]]["out"]).abs().max())
                 results[impl]["batches"][str(frames)] = entry
+            if compiled:
+                results["csr"]["batches"][str(frames)]["compiled"] = {
+                    name: {**first_calls[name],
+                           "best_s": timed["compiled " + name]["best_s"],
+                           "median_s": timed["compiled " + name]["median_s"],
+                           "max_diff_m": float((timed["compiled " + name]["out"]
+                                                - timed["csr"]["out"]).abs().max())}
+                    for name in compiled}
             for mode in ("bf16", "bf16_processors"):
                 if mode in timed:
                     error = (timed[mode]["out"] - timed["csr"]["out"]).abs() * 1000  # mm
@@ -313,6 +536,9 @@ def child(args: argparse.Namespace) -> None:
                 models["csr"](contexts["csr"], *inputs)
             results["csr"]["profile"] = prof.key_averages().table(
                 sort_by="self_cpu_time_total", row_limit=12)
+    if args.onnx and "csr" in models:  # outside inference_mode: the exporters trace
+        with torch.no_grad():
+            results["csr"]["onnx"] = onnx_check(models["csr"], pair, max(args.batches))
     for result in results.values():
         print("RESULT " + json.dumps(result))
 
@@ -364,7 +590,8 @@ def measure_simulator(pos: np.ndarray, faces: np.ndarray, frames: int) -> float 
 
 
 def label(r: dict) -> str:
-    return f"{r['config']} | {r['attention']} | {r.get('malloc', 'default')} | {r['threads']}"
+    attention = r["attention"] + (f" (child: {r['child']})" if "child" in r else "")
+    return f"{r['config']} | {attention} | {r.get('malloc', 'default')} | {r['threads']}"
 
 
 def report(results: list[dict]) -> dict[str, float]:
@@ -423,6 +650,42 @@ def report(results: list[dict]) -> dict[str, float]:
                           f"| {int(frames) / m['best_s']:.1f} "
                           f"| {e['best_s'] / m['best_s']:.2f}× | {m['max_mm']:.3f} "
                           f"| {m['mean_mm']:.4f} | {m['processor_rel']:.1e} |")
+    if any("compiled" in e for r in results for e in r["batches"].values()):
+        print("\n## compiled variants (torch.compile, inductor CPU; onnxruntime MatMul) vs "
+              "eager, csr, float32")
+        print("Interleaved with the eager runs of the same process. first call: compile + "
+              "one run at this batch size (a recompile for the second size); graphs / "
+              "breaks: what dynamo compiled at that call; ratio: eager time ÷ compiled "
+              "time (> 1: compiled faster); Δ: max |posed(compiled) − posed(eager)|.")
+        print("| config | malloc | threads | batch | compiled | first call s | graphs "
+              "| breaks | eager frames/s | compiled frames/s | ratio (best) "
+              "| ratio (median) | Δ m |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+        for r in results:
+            for frames, e in r["batches"].items():
+                for name, c in e.get("compiled", {}).items():
+                    print(f"| {r['config']} | {r.get('malloc', 'default')} | {r['threads']} "
+                          f"| {frames} | {name} | {c['first_call_s']:.1f} | {c['graphs']} "
+                          f"| {c['breaks']} | {int(frames) / e['best_s']:.1f} "
+                          f"| {int(frames) / c['best_s']:.1f} | {e['best_s'] / c['best_s']:.2f} "
+                          f"| {e['median_s'] / c['median_s']:.2f} | {c['max_diff_m']:.1e} |")
+    for r in results:
+        if "onnx" not in r:
+            continue
+        o = r["onnx"]
+        print(f"\n## ONNX, {label(r)}: supervised M^mp submodule, {o['frames']} frames")
+        for exporter, outcome in o["export"].items():
+            print(f"{exporter}: {outcome['outcome']} ({outcome['s']:.1f} s)")
+        if isinstance(o["matmul"], str):
+            print(f"onnxruntime MatMul: {o['matmul']}")
+        else:
+            print(f"onnxruntime {o['onnxruntime']} MatMul vs torch ({r['threads']} threads, "
+                  "median of 8, interleaved):")
+            print("| projection | torch ms | onnxruntime ms | torch ÷ ORT | max rel. diff |")
+            print("|---|---|---|---|---|")
+            for name, m in o["matmul"].items():
+                print(f"| {name} | {1000 * m['torch']:.1f} | {1000 * m['onnxruntime']:.1f} "
+                      f"| {m['torch'] / m['onnxruntime']:.2f} | {m['max_rel']:.1e} |")
     for r in results:
         print(f"\n{label(r)}: prepare (per pair, once) {r['prepare_s']:.2f} s; peak RSS "
               f"after prepare {r['rss_after_prepare_mb']:.0f} MB")
@@ -453,6 +716,22 @@ def main() -> None:
                         help="glibc malloc settings of the csr runs (pyg: default)")
     parser.add_argument("--profile-batch", type=int, default=16,
                         help="print the top operators of the csr runs at this batch")
+    parser.add_argument("--compile", choices=["off", "on"], default="off",
+                        help="on: also time torch.compile'd copies of the csr model, "
+                             "interleaved with eager csr (always timed: the reference)")
+    parser.add_argument("--compile-target", nargs="+", default=["model"],
+                        choices=COMPILE_TARGETS,
+                        help="what --compile on compiles (each value a variant)")
+    parser.add_argument("--compile-mode", nargs="+", default=["default"],
+                        choices=["default", "max-autotune-no-cudagraphs"],
+                        help="torch.compile mode (each value a variant)")
+    parser.add_argument("--compile-cache", choices=["cold", "warm"], default="cold",
+                        help="cold: each compiled child starts with an empty inductor "
+                             "cache (the first call is the full compile); warm: the "
+                             "default cache, as a second run on the same machine")
+    parser.add_argument("--onnx", action="store_true",
+                        help="try exporting M^mp to ONNX; time onnxruntime's MatMul, alone "
+                             "and inside M^mp (needs onnxruntime and onnx)")
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--config", help=argparse.SUPPRESS)
     parser.add_argument("--impl", nargs="+", help=argparse.SUPPRESS)
@@ -466,35 +745,70 @@ def main() -> None:
           f"{os.cpu_count()} cores")
     results = []
     variants = ["default", "tuned"] if args.malloc == "both" else [args.malloc]
-    for threads, config, malloc in ((t, c, m) for t in args.threads for c in args.configs
-                                    for m in variants):
-        # All implementations in one child, interleaved; the tuned-malloc child only
-        # repeats the csr runs (the environment must be set when the process starts).
-        impls = args.attention if malloc == variants[0] else ["csr"]
+    # Compiled variants: one child each (with its own eager csr reference, interleaved),
+    # since dynamo's caches live on the code objects that all variants share: in one
+    # process a second variant would reuse the first one's graphs and its first call
+    # would not show its compile time.
+    extras: list[tuple[str, list[str]]] = []
+    if args.compile == "on":
+        extras += [(f"compile {target}/{mode}",
+                    ["--compile", "on", "--compile-target", target, "--compile-mode", mode])
+                   for target in args.compile_target for mode in args.compile_mode]
+    if args.onnx:
+        extras.append(("onnx", ["--onnx"]))
+    jobs = []
+    for threads, config in ((t, c) for t in args.threads for c in args.configs):
+        for malloc in variants:
+            # All implementations in one child, interleaved; the tuned-malloc child only
+            # repeats the csr runs (the environment must be set when the process starts).
+            impls = args.attention if malloc == variants[0] else ["csr"]
+            # Without pyg, bf16 or a profile, the extras' children measure all of it.
+            redundant = (extras and impls == ["csr"] and not args.bf16
+                         and args.profile_batch not in args.batches)
+            if not redundant:
+                jobs.append((threads, config, malloc, impls, None, []))
+            if malloc == variants[0]:
+                jobs += [(threads, config, malloc, ["csr"], name, extra)
+                         for name, extra in extras]
+    for threads, config, malloc, impls, extra_name, extra in jobs:
+        main_child = extra_name is None
         command = [sys.executable, __file__, "--child", "--config", config,
                    "--checkpoint", args.checkpoint,
                    "--impl", *impls, "--vertices", str(args.vertices),
                    "--repeats", str(args.repeats), "--threads", str(threads),
                    "--profile-batch",
-                   str(args.profile_batch if malloc == variants[0] else -1),
-                   "--batches", *map(str, args.batches)]
-        if not args.bf16 or malloc != variants[0]:
+                   str(args.profile_batch if main_child and malloc == variants[0] else -1),
+                   "--batches", *map(str, args.batches), *extra]
+        if not args.bf16 or malloc != variants[0] or not main_child:
             command.append("--no-bf16")
         env = dict(os.environ, **(MALLOC_TUNED if malloc == "tuned" else {}))
         if threads == "auto":  # the choice is the child's, not a variable's
             env.pop("OMP_NUM_THREADS", None)
+        cache = None
+        if extra_name is not None and extra_name.startswith("compile") \
+                and args.compile_cache == "cold":
+            # An empty inductor cache: the first call shows the whole compile time, as
+            # on a fresh machine (warm: whatever earlier runs left in the default cache).
+            cache = tempfile.TemporaryDirectory(prefix="inductor-cache-")
+            env["TORCHINDUCTOR_CACHE_DIR"] = cache.name
         tic = time.perf_counter()
         done = subprocess.run(command, capture_output=True, text=True, env=env, check=False)
+        if cache is not None:
+            cache.cleanup()
         lines = [ln for ln in done.stdout.splitlines() if ln.startswith("RESULT ")]
+        what = f"{config}/{malloc}/{threads} threads" + (f" ({extra_name})" if extra else "")
         if done.returncode != 0 or not lines:
-            print(f"{config}/{malloc}/{threads} threads failed:\n{done.stderr[-3000:]}")
+            print(f"{what} failed:\n{done.stderr[-3000:]}")
             continue
         for line in lines:
             result = json.loads(line[len("RESULT "):])
             result["malloc"] = malloc
+            if extra_name is not None:
+                result["child"] = extra_name
             results.append(result)
-        print(f"measured {config} ({', '.join(impls)}), malloc {malloc}, {threads} threads, "
-              f"in {time.perf_counter() - tic:.0f} s", flush=True)
+        print(f"measured {config} ({', '.join(impls)}), malloc {malloc}, {threads} threads"
+              f"{f', {extra_name}' if extra_name else ''}, in {time.perf_counter() - tic:.0f} s",
+              flush=True)
     best = report(results)
 
     print()
