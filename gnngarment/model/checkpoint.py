@@ -134,7 +134,7 @@ def model_payload(model: GarmentDeformer) -> dict[str, Any]:
 
 #: Settings added to :class:`ModelConfig` after checkpoints were first saved, with the
 #: value that reproduces the models saved without them (not the current default).
-LEGACY_MODEL_SETTINGS = {"weight_prior": "none"}
+LEGACY_MODEL_SETTINGS = {"weight_prior": "none", "weight_reach": None}
 
 
 def stored_model_config(stored: dict[str, Any], source: str = "<checkpoint>") -> ModelConfig:
@@ -177,16 +177,36 @@ def load_model(path: str | Path) -> GarmentDeformer:
 #: What a released (shipped) checkpoint keeps: enough to rebuild the model and to say how
 #: it was made; the optimiser, scheduler and RNG states only matter for resuming.
 RELEASE_KEYS = ("model_config", "model_state", "use_physics", "epoch", "schedule",
-                "training_config", "data_manifest_hash", "history", ENVIRONMENT_KEY)
+                "training_config", "data_manifest_hash", "history", ENVIRONMENT_KEY,
+                "release_settings")
 
 
-def release_checkpoint(source: str | Path, destination: str | Path) -> Path:
+def release_checkpoint(source: str | Path, destination: str | Path,
+                       model_settings: dict[str, Any] | None = None) -> Path:
     """Write ``source`` without its training-only state (optimiser, scheduler, RNG) to
     ``destination`` (atomically): a training run's ``last.pt`` → a model to ship.
 
+    ``model_settings`` changes model-config values that need no retraining (e.g.
+    ``{"weight_reach": 0.2}``, which only masks the weight head); they are recorded under
+    ``release_settings`` so the checkpoint says its config is not the one it trained with.
+
     Raises:
-        ValueError: ``source`` is not a readable checkpoint (names it).
+        ValueError: ``source`` is not a readable checkpoint (names it), or a setting
+            is unknown, invalid, or changes the weights' shapes.
     """
     payload = load_checkpoint(source)
-    save_checkpoint(destination, {k: payload[k] for k in RELEASE_KEYS if k in payload})
+    released = {k: payload[k] for k in RELEASE_KEYS if k in payload}
+    if model_settings:
+        config = stored_model_config({**released["model_config"], **model_settings},
+                                     source=f"{source} + {model_settings}")
+        model = GarmentDeformer(config)          # validates the settings (ValueError)
+        try:
+            model.load_state_dict(released["model_state"])
+        except RuntimeError as error:
+            raise ValueError(f"{source}: {model_settings} does not fit its weights: "
+                             f"{str(error).splitlines()[0][:200]}") from None
+        released["model_config"] = asdict(config)
+        released["release_settings"] = {**released.get("release_settings", {}),
+                                         **model_settings}
+    save_checkpoint(destination, released)
     return Path(destination)

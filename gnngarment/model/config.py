@@ -55,7 +55,9 @@ class ModelConfig:
         weight_reach: with the ``body`` prior, the distance (metres) beyond which a
             joint may not move a garment vertex: joints whose garment region (vertices
             it moves by at least 0.1 in the body weights) is farther away get no weight
-            at all. ``None`` (what older checkpoints load as) allows every joint.
+            at all. ``None`` (what checkpoints saved before it existed load as) allows
+            every joint. The paper's head (``weight_prior: none``) has no prior to
+            limit and ignores it.
     """
 
     garment_channels: list[int] = field(default_factory=lambda: [32, 64, 128, 128])
@@ -76,7 +78,7 @@ class ModelConfig:
     dropout: float = 0.0
     attention: str = "csr"
     weight_prior: str = "body"
-    weight_reach: float | None = None
+    weight_reach: float | None = 0.2
 
     @property
     def feature_channels(self) -> int:
@@ -107,13 +109,9 @@ class ModelConfig:
         if self.weight_prior not in WEIGHT_PRIORS:
             raise ValueError(f"weight_prior must be one of {WEIGHT_PRIORS}, "
                              f"got '{self.weight_prior}'")
-        if self.weight_reach is not None:
-            if self.weight_prior != "body":
-                raise ValueError("weight_reach needs weight_prior 'body' (it limits the "
-                                 f"prior's joints), got weight_prior '{self.weight_prior}'")
-            if not self.weight_reach > 0:
-                raise ValueError(f"weight_reach must be positive (metres) or null, "
-                                 f"got {self.weight_reach}")
+        if self.weight_reach is not None and not self.weight_reach > 0:
+            raise ValueError(f"weight_reach must be positive (metres) or null, "
+                             f"got {self.weight_reach}")
         if not 0 <= self.levels <= MAX_LEVELS:
             raise ValueError(f"levels must be in 0..{MAX_LEVELS}, got {self.levels}")
         if not 0 < self.pooling_ratio < 1:

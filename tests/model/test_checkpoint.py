@@ -74,3 +74,20 @@ def test_every_checkpoint_records_threads_and_library_versions(model: GarmentDef
     save_checkpoint(path, {**model_payload(model), "environment": recorded})
     released = release_checkpoint(path, tmp_path / "released.pt")
     assert load_checkpoint(released)["environment"] == recorded
+
+
+def test_a_release_can_set_a_reach_but_not_change_the_network(model: GarmentDeformer,
+                                                               tmp_path: Path) -> None:
+    """Settings that need no retraining are applied and recorded; an invalid one or one
+    that changes the weights' shapes is refused before anything is written."""
+    path = tmp_path / "model.pt"
+    save_checkpoint(path, model_payload(GarmentDeformer(tiny_config(weight_reach=None))))
+    released = release_checkpoint(path, tmp_path / "released.pt", {"weight_reach": 0.15})
+    assert load_model(released).config.weight_reach == 0.15
+    assert load_checkpoint(released)["release_settings"] == {"weight_reach": 0.15}
+    assert load_model(path).config.weight_reach is None
+    for settings, message in (({"weight_reach": -1.0}, "weight_reach must be positive"),
+                              ({"processor_channels": 8}, "does not fit its weights")):
+        with pytest.raises(ValueError, match=message):
+            release_checkpoint(path, tmp_path / "refused.pt", settings)
+    assert not (tmp_path / "refused.pt").exists()

@@ -35,7 +35,7 @@ def floored(weights: torch.Tensor) -> torch.Tensor:
 
 
 def test_untrained_body_prior_is_body_skinning(garment) -> None:
-    model = build()
+    model = build(weight_reach=None)
     pair = make_pair(*garment, model.config)
     pair.body_weights[:5] = torch.eye(24)[:5]  # exact zeros meet the floor
     motion, velocity, transforms = frame_inputs(model.config, 1, 3, seed=2)
@@ -51,8 +51,21 @@ def test_untrained_body_prior_is_body_skinning(garment) -> None:
     torch.testing.assert_close(out.posed, lbs, atol=1e-5, rtol=0)
 
 
-def test_body_prior_is_per_pair_in_a_batch(garment) -> None:
+def test_untrained_head_with_a_reach_is_body_skinning_on_the_reachable_joints(garment
+                                                                              ) -> None:
+    from gnngarment.body.joint_reach import reachable_joints
+
     model = build()
+    assert model.config.weight_reach == 0.2
+    pair = make_pair(*garment, model.config)
+    out = model(model.prepare([pair]), *frame_inputs(model.config, 1, 2))
+    kept = floored(pair.body_weights) * reachable_joints(pair.rest_pos, pair.body_weights, 0.2)
+    expected = (kept / kept.sum(-1, keepdim=True)).repeat(2, 1)
+    torch.testing.assert_close(out.weights, expected, atol=1e-6, rtol=0)
+
+
+def test_body_prior_is_per_pair_in_a_batch(garment) -> None:
+    model = build(weight_reach=None)
     pairs = [make_pair(*garment, model.config, seed=1), make_pair(*tube(6, 8), model.config,
                                                                 seed=2)]
     out = model(model.prepare(pairs), *frame_inputs(model.config, 2, 2))
@@ -140,14 +153,15 @@ def test_unknown_prior_is_rejected() -> None:
 
 
 def test_checkpoints_keep_their_prior(garment, tmp_path) -> None:
-    """A checkpoint saved before ``weight_prior`` existed has no such key (and no gate):
-    it loads as ``none`` and predicts as before. A new one keeps its own prior."""
-    old = build(seed=3, weight_prior="none")
+    """A checkpoint saved before ``weight_prior`` and ``weight_reach`` existed has no
+    such keys (and no gate): it loads as ``none`` without a reach and predicts as before.
+    A new one keeps its own prior and reach."""
+    old = build(seed=3, weight_prior="none", weight_reach=None)
     payload = model_payload(old)
-    del payload["model_config"]["weight_prior"]
+    del payload["model_config"]["weight_prior"], payload["model_config"]["weight_reach"]
     save_checkpoint(tmp_path / "old.pt", payload)
     loaded = load_model(tmp_path / "old.pt")
-    assert loaded.config.weight_prior == "none"
+    assert loaded.config.weight_prior == "none" and loaded.config.weight_reach is None
     pair = make_pair(*garment, old.config)
     inputs = frame_inputs(old.config, 1, 2)
     assert torch.equal(old(old.prepare([pair]), *inputs).posed,
@@ -184,10 +198,7 @@ def test_weight_reach_gives_far_joints_no_weight(garment) -> None:
             assert weights[far].max() == 0
 
 
-@pytest.mark.parametrize("overrides,message", [
-    ({"weight_reach": 0.2, "weight_prior": "none"}, "weight_reach needs weight_prior"),
-    ({"weight_reach": -0.1}, "weight_reach must be positive"),
-])
-def test_bad_weight_reach_is_rejected(overrides, message: str) -> None:
-    with pytest.raises(ValueError, match=message):
-        GarmentDeformer(tiny_config(**overrides))
+@pytest.mark.parametrize("reach", [-0.1, 0.0])
+def test_bad_weight_reach_is_rejected(reach: float) -> None:
+    with pytest.raises(ValueError, match="weight_reach must be positive"):
+        GarmentDeformer(tiny_config(weight_reach=reach))
