@@ -240,6 +240,25 @@ def _offsets(sizes: Sequence[int]) -> list[int]:
     return offsets
 
 
+def check_pair_fits(pair: GarmentBodyPair, config: ModelConfig) -> None:
+    """Raise ``ValueError`` (naming the setting) when ``pair`` was prepared for another
+    model config: descriptor length ≠ ``landmarks``, body features for another
+    ``body_vertices``, fewer pooling levels than the model pools, or no body weights
+    for the ``body`` prior. Checked once when a trainer is built, before any epoch."""
+    try:
+        _check_pair(0, pair, config)
+    except ValueError as error:
+        message = str(error).removeprefix("pair 0: ")
+        hints = {"descriptor": "landmarks", "body_distances": "body_vertices"}
+        for field_name, setting in hints.items():
+            if message.startswith(field_name):
+                message += f" (the model's {setting} is {getattr(config, setting)})"
+        raise ValueError(message) from None
+    if config.pooling == "structure" and pair.hierarchy.depth < config.levels:
+        raise ValueError(f"its pooling hierarchy has {pair.hierarchy.depth} levels, the "
+                         f"model pools {config.levels} (levels)")
+
+
 def _check_pair(index: int, pair: GarmentBodyPair, config: ModelConfig) -> None:
     n = pair.rest_pos.shape[0]
     expected = {

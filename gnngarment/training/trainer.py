@@ -17,7 +17,8 @@ from torch import nn
 from gnngarment.data.dataset import PreparedDataset, TrainingBatch
 from gnngarment.io.atomic import atomic_write_bytes
 from gnngarment.model.checkpoint import load_checkpoint, model_payload, save_checkpoint
-from gnngarment.model.deformer import DeformerOutput, GarmentDeformer
+from gnngarment.model.config import ModelConfig
+from gnngarment.model.deformer import DeformerOutput, GarmentDeformer, check_pair_fits
 from gnngarment.training.config import TrainingConfig
 from gnngarment.training.objective import stage_loss
 from gnngarment.training.rng import rng_state, set_rng_state
@@ -45,6 +46,18 @@ class TrainingStep(nn.Module):
         context = self.model.prepare(batch.pairs)
         return self.model(context, batch.motion_windows, batch.velocity_windows,
                           batch.joint_transforms)
+
+
+def _check_cache_fits(dataset: PreparedDataset, model: ModelConfig) -> None:
+    """Refuse a cache prepared for another model config before the first epoch, naming
+    the cache and the setting (a mismatch would otherwise surface mid-epoch)."""
+    name = dataset.sequence_names[0]
+    try:
+        check_pair_fits(dataset.garment_of(name).pair, model)
+    except ValueError as error:
+        raise ValueError(f"{dataset.root}: {name}: {error}: the cache was prepared for "
+                         "another model config (rebuild it, or change the model config)"
+                         ) from None
 
 
 def set_stage(model: GarmentDeformer, stage: str) -> None:
@@ -92,6 +105,9 @@ class Trainer:
         torch.use_deterministic_algorithms(config.deterministic)
         torch.manual_seed(config.seed)
         self.model = GarmentDeformer(config.model)
+        for dataset in (train, validation):
+            if dataset is not None and len(dataset):
+                _check_cache_fits(dataset, config.model)
         self.step_module: nn.Module = TrainingStep(self.model)
         self._wrapped_stage: str | None = None
         self.optimiser = torch.optim.Adamax(self.model.parameters(), lr=config.learning_rate)

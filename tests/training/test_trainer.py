@@ -143,3 +143,19 @@ def test_released_checkpoint_drops_training_state_and_predicts_the_same(
         a = TrainingStep(load_model(tmp_path / "run" / "last.pt"))(batch).posed
         b = TrainingStep(load_model(released))(batch).posed
     assert torch.equal(a, b)
+
+
+@pytest.mark.parametrize("setting,value,message", [
+    ("landmarks", 32, r"descriptor has shape .* \(the model's landmarks is 32\)"),
+    ("body_vertices", 64, r"body_distances has shape .* \(the model's body_vertices is 64\)"),
+    ("levels", 3, r"its pooling hierarchy has 2 levels, the model pools 3 \(levels\)"),
+])
+def test_a_cache_prepared_for_another_model_is_refused_before_training(
+        cache: Path, tmp_path: Path, setting: str, value: int, message: str) -> None:
+    from dataclasses import replace
+
+    config = config_for(cache, tmp_path / "run")
+    config = replace(config, model=replace(config.model, **{setting: value}))
+    with pytest.raises(ValueError, match=f"{cache}: .*: {message}: the cache was prepared"):
+        make_trainer(config)
+    assert not (tmp_path / "run").exists()
