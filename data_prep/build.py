@@ -545,7 +545,8 @@ def _sequence_done(root: Path, name: str, inputs_hash: str) -> bool:
 
 def build_dataset(config: DataConfig, workers: int | None = None,
                   log: Callable[[str], None] = print) -> dict[str, Any]:
-    """Build (or resume) the dataset of ``config`` under ``config.output``.
+    """Build (or resume) the dataset of ``config`` under ``config.output``. Validation and
+    test sequences are simulated before the training ones.
 
     Returns:
         The build report (also written to ``build_report.json``).
@@ -644,6 +645,9 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
                 known_failures[plan.name] = reason
                 continue
             tasks.append((str(root), plan, config, inputs_hash))
+        # Held-out sequences first: an interrupted or still-running build can already be
+        # evaluated on them (sorted stably, so each group keeps the plan's order).
+        tasks.sort(key=lambda task: task[1].split == "train")
         log(f"{len(plans)} sequences planned: {skipped} already built, {len(known_failures)} "
             f"failed before with the same inputs, {len(tasks)} to simulate with "
             f"{executor.parallelism(len(tasks))} worker(s)")
