@@ -29,7 +29,7 @@ from data_prep.cloth3d_build import build_from_cloth3d
 from gnngarment.geometry import load_mesh
 from tests.smpl_files import write_synthetic_smpl
 
-REAL_WORLD = Path(__file__).resolve().parents[2].parent / "shared" / "real-world"
+REAL_WORLD = Path(__file__).resolve().parents[3].parent / "shared" / "real-world"
 SAMPLE = REAL_WORLD / "cloth3d" / "00006"
 GARMENTS = ("Top", "Trousers")
 
