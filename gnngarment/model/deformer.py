@@ -148,7 +148,10 @@ class GarmentDeformer(nn.Module):
             raise ValueError("prepare() needs at least one garment-body pair")
         sizes = [int(pair.rest_pos.shape[0]) for pair in pairs]
         for index, pair in enumerate(pairs):
-            _check_pair(index, pair, self.config)
+            try:
+                check_pair_fits(pair, self.config)
+            except ValueError as error:
+                raise ValueError(f"pair {index}: {error}") from None
         device = pairs[0].features.device
         features = torch.cat([pair.features for pair in pairs])
         edge_index = torch.cat([
@@ -241,52 +244,45 @@ def _offsets(sizes: Sequence[int]) -> list[int]:
 
 
 def check_pair_fits(pair: GarmentBodyPair, config: ModelConfig) -> None:
-    """Raise ``ValueError`` (naming the setting) when ``pair`` was prepared for another
-    model config: descriptor length ≠ ``landmarks``, body features for another
-    ``body_vertices``, fewer pooling levels than the model pools, or no body weights
-    for the ``body`` prior. Checked once when a trainer is built, before any epoch."""
-    try:
-        _check_pair(0, pair, config)
-    except ValueError as error:
-        message = str(error).removeprefix("pair 0: ")
-        hints = {"descriptor": "landmarks", "body_distances": "body_vertices"}
-        for field_name, setting in hints.items():
-            if message.startswith(field_name):
-                message += f" (the model's {setting} is {getattr(config, setting)})"
-        raise ValueError(message) from None
-    if config.pooling == "structure" and pair.hierarchy.depth < config.levels:
-        raise ValueError(f"its pooling hierarchy has {pair.hierarchy.depth} levels, the "
-                         f"model pools {config.levels} (levels)")
-
-
-def _check_pair(index: int, pair: GarmentBodyPair, config: ModelConfig) -> None:
+    """Raise ``ValueError`` (naming the array, and the setting where one decides its
+    shape) when ``pair`` does not fit a model of ``config``: wrong shapes or non-finite
+    values, a descriptor of another length than ``landmarks``, body features for
+    another ``body_vertices``, fewer pooling levels than the model pools, or no body
+    weights for the ``body`` prior. :meth:`GarmentDeformer.prepare` checks every pair;
+    a trainer checks its cache's first one before any epoch."""
     n = pair.rest_pos.shape[0]
     expected = {
         "rest_pos": (n, 3), "features": (n, VERTEX_FEATURE_CHANNELS),
         "descriptor": (config.landmarks,), "body_distances": (config.body_vertices, NUM_JOINTS),
     }
+    setting_of = {"descriptor": "landmarks", "body_distances": "body_vertices"}
     for name, shape in expected.items():
         actual = tuple(getattr(pair, name).shape)
         if actual != shape:
-            raise ValueError(f"pair {index}: {name} has shape {actual}, expected {shape}")
+            hint = (f" (the model's {setting_of[name]} is {getattr(config, setting_of[name])})"
+                    if name in setting_of else "")
+            raise ValueError(f"{name} has shape {actual}, expected {shape}{hint}")
         if not torch.isfinite(getattr(pair, name)).all():
-            raise ValueError(f"pair {index}: {name} contains NaN or inf")
+            raise ValueError(f"{name} contains NaN or inf")
     if config.weight_prior == "body":
-        _check_body_weights(index, pair.body_weights, n)
+        _check_body_weights(pair.body_weights, n)
     if pair.hierarchy.num_vertices != n:
-        raise ValueError(f"pair {index}: hierarchy has {pair.hierarchy.num_vertices} vertices, "
+        raise ValueError(f"hierarchy has {pair.hierarchy.num_vertices} vertices, "
                          f"garment has {n}")
+    if config.pooling == "structure" and pair.hierarchy.depth < config.levels:
+        raise ValueError(f"its pooling hierarchy has {pair.hierarchy.depth} levels, the "
+                         f"model pools {config.levels} (levels)")
 
 
-def _check_body_weights(index: int, body_weights: torch.Tensor | None, n: int) -> None:
+def _check_body_weights(body_weights: torch.Tensor | None, n: int) -> None:
     if body_weights is None:
-        raise ValueError(f"pair {index}: body_weights is missing; weight_prior 'body' needs "
+        raise ValueError("body_weights is missing; weight_prior 'body' needs "
                          f"the garment's transferred body skinning weights ({n}, {NUM_JOINTS})")
     if tuple(body_weights.shape) != (n, NUM_JOINTS):
-        raise ValueError(f"pair {index}: body_weights has shape {tuple(body_weights.shape)}, "
+        raise ValueError(f"body_weights has shape {tuple(body_weights.shape)}, "
                          f"expected {(n, NUM_JOINTS)}")
     if not torch.isfinite(body_weights).all():
-        raise ValueError(f"pair {index}: body_weights contains NaN or inf")
+        raise ValueError("body_weights contains NaN or inf")
 
 
 def _check_frames(motion: torch.Tensor, velocity: torch.Tensor, transforms: torch.Tensor,
