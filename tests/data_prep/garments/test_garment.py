@@ -1,4 +1,6 @@
-"""Procedural garments on the synthetic body (fast): validity, fit, sampler, validators."""
+"""`make_garment` / `sample_garment`, the whole generator: every type clean, around the
+body and where clothes sit; resolution, styles, seeds, the sampler; on the synthetic body
+(T- and A-pose, another build) and on Anny bodies (T- and A-pose, two shapes)."""
 
 from __future__ import annotations
 
@@ -10,27 +12,15 @@ import pytest
 from data_prep.garments import (
     GARMENT_TYPES,
     BodyFrame,
-    Garment,
     GarmentError,
     SkirtStyle,
     TShirtStyle,
-    flared_skirt,
     garment_problems,
     make_garment,
     sample_garment,
-    self_intersections,
     synthetic_body,
 )
-from data_prep.garments.body_distance import BodyDistance
-from data_prep.garments.flips import delaunay_flips
-from data_prep.garments.measurements import ARM_L, ARM_R, HEAD, TRUNK
-from gnngarment.body.skeleton import JOINT_INDEX
-from gnngarment.geometry import (
-    check_mesh,
-    connected_components,
-    edge_index_from_faces,
-    vertex_normals,
-)
+from gnngarment.geometry import check_mesh, vertex_normals
 
 OPENINGS = {
     "skirt": {"waist", "hem"},
@@ -42,43 +32,6 @@ OPENINGS = {
 }
 TOP_OPENING = {"skirt": "waist", "trousers": "waist", "tshirt": "neck", "top": "neck",
                "dress": "neck", "jumpsuit": "neck"}
-
-
-@pytest.fixture(scope="module")
-def body() -> BodyFrame:
-    return synthetic_body(arm_angle_deg=0.0)
-
-
-@pytest.fixture(scope="module")
-def garments(body: BodyFrame) -> dict:
-    """One garment per type, default style, 1500 vertices."""
-    return {kind: make_garment(body, kind, target_vertices=1500, seed=3) for kind in GARMENT_TYPES}
-
-
-# ---- the stand-alone cone skirt (used by the demo and benchmarks) ---------------------
-
-
-def test_flared_skirt_is_a_clean_outward_facing_tube() -> None:
-    pos, faces = flared_skirt(1500, waist_radius=0.15, hem_radius=0.4, length=0.5, seed=3)
-    report = check_mesh(pos, faces)
-    assert report.ok and not report.findings, report.errors + report.findings
-    assert abs(len(pos) - 1500) < 20
-    assert connected_components(edge_index_from_faces(faces, len(pos)), len(pos)).max() == 0
-    radial = pos[:, :2] / np.linalg.norm(pos[:, :2], axis=1, keepdims=True)
-    assert (np.einsum("ij,ij->i", vertex_normals(pos, faces)[:, :2], radial) > 0).all()
-    top, bottom = pos[:, 2] > -1e-9, pos[:, 2] < -0.5 + 1e-9
-    np.testing.assert_allclose(np.linalg.norm(pos[top, :2], axis=1), 0.15)
-    np.testing.assert_allclose(np.linalg.norm(pos[bottom, :2], axis=1), 0.4)
-
-
-def test_flared_skirt_is_seeded() -> None:
-    a, _ = flared_skirt(400, seed=1)
-    b, _ = flared_skirt(400, seed=1)
-    c, _ = flared_skirt(400, seed=2)
-    assert np.array_equal(a, b) and not np.array_equal(a, c)
-
-
-# ---- every type: clean, around the body, where clothes sit ---------------------------
 
 
 @pytest.mark.parametrize("kind", sorted(GARMENT_TYPES))
@@ -152,9 +105,6 @@ def test_triangulations_are_irregular(garments: dict) -> None:
             interior[loop] = False
         values = np.unique(valence[interior])
         assert values.min() <= 5 and values.max() >= 7 and len(values) >= 4, garment.name
-
-
-# ---- parameters: resolution, styles, seeds -------------------------------------------
 
 
 def test_resolution_controls_the_vertex_count(body: BodyFrame) -> None:
@@ -248,105 +198,44 @@ def test_other_body_builds() -> None:
     assert garment_problems(garment, wide, clearance=0.005) == []
 
 
-# ---- the body as arrays --------------------------------------------------------------
-
-
-def test_synthetic_body_and_measurements(body: BodyFrame) -> None:
-    assert 1.55 < np.ptp(body.vertices[:, 2]) < 1.7
-    m = body.measurements
-    labels = m.labels
-    wrist = body.joint("L_wrist")
-    near_wrist = np.linalg.norm(body.vertices - wrist, axis=1) < 0.04
-    assert (labels[near_wrist] == ARM_L).all()
-    assert (labels[np.linalg.norm(body.vertices - body.joint("R_wrist"), axis=1) < 0.04]
-            == ARM_R).all()
-    assert (labels[body.vertices[:, 2] > 0.7] == HEAD).all()
-    assert (labels[np.abs(body.vertices[:, 2] - 0.2) < 0.01] == TRUNK).all()
-    assert body.joint("R_knee")[2] < m.z_crotch < body.joint("pelvis")[2]
-    assert abs(m.neck_radius - 0.055) < 0.01
-    # The chest section holds the chest ellipsoid (half-width 0.16 m).
-    chest = m.trunk.at(0.37)
-    assert 0.16 <= chest["a"] < 0.2
-    assert m.armpits["L"][0] > 0 > m.armpits["R"][0]
-
-
-def test_body_distance_on_a_sphere() -> None:
-    import trimesh
-
-    sphere = trimesh.creation.icosphere(subdivisions=4, radius=0.2)
-    distance = BodyDistance(sphere.vertices, sphere.faces)
-    rng = np.random.default_rng(0)
-    points = rng.uniform(-0.35, 0.35, (2000, 3))
-    signed = distance(points)
-    exact = np.linalg.norm(points, axis=1) - 0.2
-    np.testing.assert_allclose(signed, exact, atol=2e-3)  # chordal error of the mesh
-    inside, bound = distance.clearance(points, threshold=0.05)
-    far = np.abs(exact) > 3e-3
-    assert np.array_equal(inside[far], exact[far] < 0)
-    assert (bound <= np.abs(signed) + 1e-12).all()
-    # Two overlapping spheres: the union's distance is the minimum.
-    shifted = np.asarray(sphere.vertices) + np.array([0.3, 0.0, 0.0])
-    union = BodyDistance(np.concatenate([sphere.vertices, shifted]),
-                         np.concatenate([sphere.faces, sphere.faces + len(sphere.vertices)]))
-    both = np.minimum(exact, np.linalg.norm(points - [0.3, 0, 0], axis=1) - 0.2)
-    np.testing.assert_allclose(union(points), both, atol=2e-3)
-
-
-# ---- validators ----------------------------------------------------------------------
-
-
-def test_self_intersections_on_tiny_cases() -> None:
-    pos = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0],
-                    [0.2, 0.2, -0.5], [0.3, 0.2, 0.5], [0.2, 0.3, 0.5]], dtype=float)
-    assert len(self_intersections(pos, np.array([[0, 1, 2], [3, 4, 5]]))) == 1
-    apart = pos + np.array([[0, 0, 0]] * 3 + [[5, 0, 0]] * 3)
-    assert len(self_intersections(apart, np.array([[0, 1, 2], [3, 4, 5]]))) == 0
-    # Triangles sharing a vertex are not reported.
-    assert len(self_intersections(pos, np.array([[0, 1, 2], [0, 4, 5]]))) == 0
-
-
-def test_garment_problems_catches_defects(garments: dict, body: BodyFrame) -> None:
-    garment = garments["tshirt"]
-    assert garment_problems(garment, body) == []
-    flipped = _copy(garment)
-    flipped.faces[0] = flipped.faces[0, ::-1]
-    assert any("orientation" in p for p in garment_problems(flipped, body))
-    inside = _copy(garment)
-    chest = int(np.argmin(np.linalg.norm(inside.pos - body.joint("spine3"), axis=1)))
-    inside.pos[chest] = body.joint("spine3")
-    assert any("inside the body" in p for p in garment_problems(inside, body))
-    # A chest vertex pulled through to behind the back: its triangles cross the back.
-    through = _copy(garment)
-    chest = np.flatnonzero(np.abs(through.pos[:, 2] - body.joint("spine3")[2]) < 0.03)
-    front = chest[np.argmin(through.pos[chest, 1])]
-    through.pos[front, 1] = through.pos[:, 1].max() + 0.05
-    assert any("self-intersecting" in p for p in garment_problems(through, body))
-    inward = _copy(garment)
-    inward.faces = inward.faces[:, ::-1].copy()
-    assert any("face away" in p for p in garment_problems(inward, body))
-    assert any("boundary loops" in p for p in garment_problems(garment, body, 3))
-
-
-def test_delaunay_flips_keep_a_valid_mesh(garments: dict) -> None:
-    garment = garments["dress"]
-    rng = np.random.default_rng(0)
-    noisy = garment.pos + rng.normal(0, 0.004, garment.pos.shape)
-    faces = delaunay_flips(noisy, garment.faces)
-    report = check_mesh(noisy, faces)
-    assert report.ok and not report.findings
-    assert len(faces) == len(garment.faces)
-
-
-def _copy(garment: Garment) -> Garment:
-    import dataclasses
-
-    return dataclasses.replace(garment, pos=garment.pos.copy(), faces=garment.faces.copy())
-
-
-def test_joint_table_is_smpl_order() -> None:
-    assert JOINT_INDEX["pelvis"] == 0 and JOINT_INDEX["neck"] == 12 and JOINT_INDEX["R_hand"] == 23
-
-
 def test_garment_error_is_a_value_error() -> None:
     assert issubclass(GarmentError, ValueError)
     assert SkirtStyle.describe()[0][0] == "waist_height"
+
+
+@pytest.mark.parametrize("kind", sorted(GARMENT_TYPES))
+def test_each_type_fits_the_t_pose(anny_bodies: dict[str, BodyFrame], kind: str) -> None:
+    body = anny_bodies["T"]
+    garment = make_garment(body, kind, target_vertices=1500, seed=1)
+    assert garment_problems(garment, body, clearance=0.005) == []
+    m = body.measurements
+    top = garment.pos[garment.pin_candidates]
+    if kind in ("skirt", "trousers"):
+        # The waistband circles the pelvis between the hip joints and the natural waist.
+        assert m.z_hip - 0.01 < top[:, 2].mean() < m.z_waist + 0.01
+        assert np.linalg.norm(top[:, :2].mean(axis=0) - body.joint("pelvis")[:2]) < 0.04
+    else:
+        # The neckline circles the neck.
+        assert abs(top[:, 0].mean() - body.joint("neck")[0]) < 0.02
+        assert top[:, 2].max() > m.z_shoulder
+    if kind == "tshirt":
+        for side in ("L", "R"):
+            cuff = garment.pos[garment.openings[f"cuff_{side}"]].mean(axis=0)
+            arm = m.arms[side]
+            on_axis = arm.point(np.linspace(0, arm.length, 300))
+            assert np.min(np.linalg.norm(on_axis - cuff, axis=1)) < 0.02
+
+
+def test_a_pose_garments(anny_bodies: dict[str, BodyFrame]) -> None:
+    body = anny_bodies["A"]
+    for kind in ("tshirt", "skirt", "trousers", "dress"):
+        garment = sample_garment(body, 5, kind, resolution=(1000, 2000))
+        assert garment_problems(garment, body, clearance=0.005) == []
+
+
+def test_samples_on_another_shape(anny_bodies: dict[str, BodyFrame]) -> None:
+    body = anny_bodies["heavy_T"]
+    rng = np.random.default_rng(3)
+    for kind in sorted(GARMENT_TYPES):
+        garment = sample_garment(body, rng, kind, resolution=(800, 2500))
+        assert garment_problems(garment, body, clearance=0.005) == []

@@ -1,4 +1,5 @@
-"""Real Newton simulations of tiny garments (a few hundred vertices, a few dozen frames).
+"""`simulate_garment`: real Newton simulations of tiny garments (a few hundred vertices, a
+few dozen frames), and its retries with more substeps.
 
 The first simulation of a process compiles Newton's kernels: ~45 s with an empty Warp
 cache (a fresh CI machine), under a second once cached in the home directory.
@@ -12,9 +13,9 @@ import trimesh
 
 from data_prep.simulate import SimulationFailed, SimulationSettings, simulate_garment
 from data_prep.simulate.inside import signed_distance
-from tests.meshes import grid, tube
+from tests.data_prep.simulate.scenes import FPS, sphere, square
+from tests.meshes import tube
 
-FPS = 30.0
 GRAVITY = 9.81
 
 
@@ -22,18 +23,6 @@ def _capsule(radius: float = 0.12, height: float = 0.5) -> tuple[np.ndarray, np.
     capsule = trimesh.creation.capsule(height=height, radius=radius, count=[16, 16])
     assert capsule.is_watertight and capsule.volume > 0  # closed, outward winding
     return np.asarray(capsule.vertices), np.asarray(capsule.faces)
-
-
-def _sphere(radius: float, centre: tuple[float, float, float] = (0.0, 0.0, 0.0),
-            subdivisions: int = 3) -> tuple[np.ndarray, np.ndarray]:
-    sphere = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
-    return np.asarray(sphere.vertices) + np.asarray(centre), np.asarray(sphere.faces)
-
-
-def _square(cells: int, size: float, height: float) -> tuple[np.ndarray, np.ndarray]:
-    """A ``size``-metre square cloth centred over the origin at z = ``height``."""
-    pos, faces = grid(cells + 1, cells + 1, spacing=size / cells)
-    return pos + np.array([-size / 2, -size / 2, height]), faces
 
 
 @pytest.fixture(scope="module")
@@ -101,9 +90,9 @@ def test_skirt_hangs_and_moves_with_the_body(skirt_on_moving_capsule) -> None:
 
 
 def test_free_cloth_falls_like_a_stone_before_contact() -> None:
-    pos, faces = _square(cells=6, size=0.3, height=1.0)
-    far_body = np.stack([_sphere(0.1, centre=(5.0, 0.0, 0.0), subdivisions=1)[0]] * 7)
-    body_faces = _sphere(0.1, subdivisions=1)[1]
+    pos, faces = square(cells=6, size=0.3, height=1.0)
+    far_body = np.stack([sphere(0.1, centre=(5.0, 0.0, 0.0), subdivisions=1)[0]] * 7)
+    body_faces = sphere(0.1, subdivisions=1)[1]
     result = simulate_garment(pos, faces, far_body, body_faces, FPS, "silk",
                               settings=SimulationSettings(settle_frames=0))
     t = np.arange(7) / FPS
@@ -118,8 +107,8 @@ def test_free_cloth_falls_like_a_stone_before_contact() -> None:
 
 def test_sphere_keeps_a_draped_cloth_outside() -> None:
     radius = 0.15
-    body_rest, body_faces = _sphere(radius)
-    pos, faces = _square(cells=12, size=0.5, height=radius + 0.05)
+    body_rest, body_faces = sphere(radius)
+    pos, faces = square(cells=12, size=0.5, height=radius + 0.05)
     body = np.stack([body_rest] * 20)
     result = simulate_garment(pos, faces, body, body_faces, FPS, "cotton",
                               settings=SimulationSettings(settle_frames=0))
@@ -135,8 +124,8 @@ def test_sphere_keeps_a_draped_cloth_outside() -> None:
 
 
 def test_failing_sequence_is_retried_with_more_substeps_then_raises() -> None:
-    pos, faces = _square(cells=4, size=0.2, height=0.5)
-    body_rest, body_faces = _sphere(0.1, centre=(5.0, 0.0, 0.0), subdivisions=1)
+    pos, faces = square(cells=4, size=0.2, height=0.5)
+    body_rest, body_faces = sphere(0.1, centre=(5.0, 0.0, 0.0), subdivisions=1)
     corner = np.array([0])  # pinned: the cloth swings and stretches a little
     settings = SimulationSettings(substeps=2, settle_frames=0, max_retries=2,
                                   retry_substep_factor=2, max_edge_stretch=1.0001,
@@ -154,8 +143,8 @@ def test_failing_sequence_is_retried_with_more_substeps_then_raises() -> None:
 
 
 def test_retries_stop_when_more_substeps_get_no_further() -> None:
-    pos, faces = _square(cells=4, size=0.2, height=0.5)
-    body_rest, body_faces = _sphere(0.1, centre=(5.0, 0.0, 0.0), subdivisions=1)
+    pos, faces = square(cells=4, size=0.2, height=0.5)
+    body_rest, body_faces = sphere(0.1, centre=(5.0, 0.0, 0.0), subdivisions=1)
     settings = SimulationSettings(substeps=2, settle_frames=0, max_retries=3,
                                   retry_substep_factor=2, max_edge_stretch=1.0001)
     assert settings.retry_only_if_progress  # the default
@@ -166,45 +155,9 @@ def test_retries_stop_when_more_substeps_get_no_further() -> None:
     assert [r.substeps for r in caught.value.reports] == [2, 4]
 
 
-def test_signed_distance_to_a_sphere() -> None:
-    radius = 0.2
-    vertices, faces = _sphere(radius, subdivisions=4)
-    rng = np.random.default_rng(0)
-    direction = rng.normal(size=(200, 3))
-    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
-    scale = rng.uniform(0.3, 1.7, size=200)
-    depth = signed_distance(direction * (radius * scale)[:, None], vertices, faces)
-    # Exact up to the tessellation (the icosphere's faces lie < 1 mm inside the sphere).
-    np.testing.assert_allclose(depth, radius * (scale - 1), atol=1.5e-3)
-    clear = np.abs(scale - 1) > 0.02  # farther from the surface than the tessellation error
-    assert ((depth < 0) == (scale < 1))[clear].all()
-
-
 def test_self_contact_option_runs() -> None:
-    body_rest, body_faces = _sphere(0.1)
-    pos, faces = _square(cells=8, size=0.4, height=0.15)
+    body_rest, body_faces = sphere(0.1)
+    pos, faces = square(cells=8, size=0.4, height=0.15)
     result = simulate_garment(pos, faces, np.stack([body_rest] * 8), body_faces, FPS, "silk",
                               settings=SimulationSettings(settle_frames=0, self_contact=True))
     assert result.quality.ok and np.isfinite(result.positions).all()
-
-
-def test_drape_settles_a_cloth_on_a_still_sphere() -> None:
-    """drape_garment: the cloth ends at rest on the sphere (centre on top, corners hanging,
-    outside the body), and a later call from the drape hardly moves it."""
-    from data_prep.simulate import drape_garment
-
-    radius = 0.15
-    body, body_faces = _sphere(radius)
-    pos, faces = _square(cells=12, size=0.5, height=radius + 0.05)
-    drape = drape_garment(pos, faces, body, body_faces, FPS, max_frames=60)
-    final = drape.positions
-    centre = np.argmin(np.linalg.norm(pos[:, :2], axis=1))
-    corners = np.argsort(-np.linalg.norm(pos[:, :2], axis=1))[:4]
-    assert final[centre, 2] == pytest.approx(radius, abs=0.015)
-    assert (final[corners, 2] < final[centre, 2] - 0.05).all()
-    assert (signed_distance(final, body, body_faces) > -0.01).all()
-    assert drape.frames <= 60 and drape.mean_displacement > 0.02
-    again = drape_garment(final, faces, body, body_faces, FPS, max_frames=10)
-    assert np.linalg.norm(again.positions - final, axis=1).mean() < 0.5 * drape.mean_displacement
-    with pytest.raises(ValueError, match="max_frames"):
-        drape_garment(pos, faces, body, body_faces, FPS, max_frames=0)
