@@ -8,7 +8,11 @@ from pathlib import Path
 
 @dataclasses.dataclass
 class BodyConfig:
-    """Which body model to use and how body/motion features are built.
+    """Which body model to use.
+
+    The body-vertex count N_b' and the motion window m are the model's
+    (``ModelConfig.body_vertices``, ``ModelConfig.window``; the cache records the former),
+    the frame rate is the dataset's or the animate call's: none of them lives here.
 
     Attributes:
         model: ``"anny"`` (default, ships with its wheel) or ``"smpl"`` (user file).
@@ -17,19 +21,12 @@ class BodyConfig:
         smpl_gender: ``neutral``, ``male`` or ``female`` (picks the file in a folder).
         anny_rest_pose: ``"tpose"`` (the canonical rest pose, arms along ±X) or
             ``"native"`` (Anny's own A-pose; mocap meant for a T-pose then looks wrong).
-        feature_vertex_count: size N_b′ of the farthest-point body-vertex subset used
-            for D and for body-vertex velocities.
-        motion_window: m, frames per temporal-encoder window (the paper gives no value).
-        fps: frame rate motions are resampled to before posing.
     """
 
     model: str = "anny"
     smpl_model_path: str = ""
     smpl_gender: str = "neutral"
     anny_rest_pose: str = "tpose"
-    feature_vertex_count: int = 512
-    motion_window: int = 10
-    fps: float = 30.0
 
 
 def load_body_config(path: str | Path | None = None) -> BodyConfig:

@@ -14,8 +14,9 @@ def test_yaml_mirrors_dataclass_defaults():
 
 
 def test_unknown_key_is_an_error(tmp_path):
+    # motion_window was a BodyConfig field no code read (the model's window is used).
     path = tmp_path / "body.yaml"
-    path.write_text("feature_vertex_cnt: 3\n")
+    path.write_text("motion_window: 10\n")
     with pytest.raises(ConfigError, match="body.yaml"):
         load_body_config(path)
 
