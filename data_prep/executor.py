@@ -12,7 +12,7 @@ import multiprocessing
 import os
 import sys
 from collections.abc import Callable, Iterator
-from typing import Any, Protocol
+from typing import Any, Protocol, Self
 
 #: The executors ``DataConfig.executor`` and ``prepare --executor`` accept.
 EXECUTORS = ("local", "ray")
@@ -71,7 +71,21 @@ def stop_with_parent(parent: int) -> None:
         os._exit(1)
 
 
-class LocalExecutor:
+class ClosedOnExit:
+    """``with executor:`` closes it on the way out — the one context-manager part the
+    local pool and the Ray executor share."""
+
+    def close(self) -> None:
+        raise NotImplementedError
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
+
+
+class LocalExecutor(ClosedOnExit):
     """A ``spawn`` process pool on this machine, made at the first non-empty map with
     ``min(workers, len(tasks))`` processes and reused by the later maps (so each worker
     process keeps its body model and compiled kernels across tasks)."""
@@ -103,12 +117,6 @@ class LocalExecutor:
             self._pool.terminate()
             self._pool.join()
             self._pool = None
-
-    def __enter__(self) -> LocalExecutor:
-        return self
-
-    def __exit__(self, *exc_info: object) -> None:
-        self.close()
 
 
 def make_executor(kind: str, workers: int | None, address: str = "") -> Executor:

@@ -17,6 +17,8 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from typing import Any
 
+from data_prep.executor import ClosedOnExit
+
 #: Ray's task retries after a worker process died (Ray's own default is 3).
 MAX_RETRIES = 3
 
@@ -40,7 +42,7 @@ def import_ray() -> Any:
     return ray
 
 
-class RayExecutor:
+class RayExecutor(ClosedOnExit):
     """Maps worker functions over a Ray cluster.
 
     Args:
@@ -117,9 +119,3 @@ class RayExecutor:
     def close(self) -> None:
         if self._owned and self._ray.is_initialized():
             self._ray.shutdown()
-
-    def __enter__(self) -> RayExecutor:
-        return self
-
-    def __exit__(self, *exc_info: object) -> None:
-        self.close()

@@ -43,6 +43,24 @@ def parse_mapping_text(text: str, suffix: str) -> Any:
     raise KeyError(suffix)
 
 
+def read_yaml(path: str | Path) -> Any:
+    """The OmegaConf node of a YAML config file, before any schema is applied: the one
+    place a config file is read (:func:`load_config`, the training loader's composition).
+
+    Raises:
+        ConfigError: the file is missing or not valid YAML (naming the file).
+    """
+    from omegaconf import OmegaConf
+
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"{path}: config file not found")
+    try:
+        return OmegaConf.load(path)
+    except Exception as error:  # yaml.YAMLError and friends
+        raise ConfigError(f"{path}: not a valid YAML file ({error})") from error
+
+
 def load_config(path: str | Path, schema: type[T], section: str | None = None) -> T:
     """Load ``path`` (YAML) into an instance of the dataclass ``schema``.
 
@@ -59,15 +77,8 @@ def load_config(path: str | Path, schema: type[T], section: str | None = None) -
         ConfigError: the file is missing or not valid YAML, a key is unknown, or a
             value has the wrong type; the message names the file and the key.
     """
-    from omegaconf import OmegaConf
-
     path = Path(path)
-    if not path.is_file():
-        raise ConfigError(f"{path}: config file not found")
-    try:
-        loaded = OmegaConf.load(path)
-    except Exception as error:  # yaml.YAMLError and friends
-        raise ConfigError(f"{path}: not a valid YAML file ({error})") from error
+    loaded = read_yaml(path)
     if section is not None:
         if section not in loaded:
             raise ConfigError(f"{path}: missing section '{section}'")

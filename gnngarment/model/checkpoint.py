@@ -148,6 +148,23 @@ def stored_model_config(stored: dict[str, Any], source: str = "<checkpoint>") ->
     return merge_config(ModelConfig, {**LEGACY_MODEL_SETTINGS, **stored}, source=source)
 
 
+def model_with_weights(config: ModelConfig, state: dict[str, Any], mismatch: str
+                       ) -> GarmentDeformer:
+    """A :class:`GarmentDeformer` built from ``config`` holding the weights ``state``.
+
+    Raises:
+        ValueError: the weights do not fit: ``mismatch`` followed by torch's first line.
+    """
+    model = GarmentDeformer(config)
+    try:
+        model.load_state_dict(state)
+    except (RuntimeError, KeyError, TypeError) as error:
+        # torch lists every mismatched key over many lines: one line names the first.
+        first = str(error).replace("\n", " ").split(". ")[0]
+        raise ValueError(f"{mismatch}: {first[:200]}") from None
+    return model
+
+
 def load_model(path: str | Path) -> GarmentDeformer:
     """Rebuild a model from a checkpoint, in eval mode.
 
@@ -160,15 +177,9 @@ def load_model(path: str | Path) -> GarmentDeformer:
     if missing:
         raise ValueError(f"{path}: not a model checkpoint (no {' or '.join(missing)})")
     config = stored_model_config(payload["model_config"], source=str(path))
-    model = GarmentDeformer(config)
-    try:
-        model.load_state_dict(payload["model_state"])
-    except (RuntimeError, KeyError, TypeError) as error:
-        # torch lists every mismatched key over many lines: one line names the first.
-        first = str(error).replace("\n", " ").split(". ")[0]
-        raise ValueError(f"{path}: the weights do not fit the model its config describes "
-                         f"(another architecture or a damaged checkpoint): {first[:200]}"
-                         ) from None
+    model = model_with_weights(config, payload["model_state"],
+                               f"{path}: the weights do not fit the model its config "
+                               "describes (another architecture or a damaged checkpoint)")
     model.use_physics = bool(payload.get("use_physics", False))
     model.eval()
     return model
@@ -199,12 +210,8 @@ def release_checkpoint(source: str | Path, destination: str | Path,
     if model_settings:
         config = stored_model_config({**released["model_config"], **model_settings},
                                      source=f"{source} + {model_settings}")
-        model = GarmentDeformer(config)          # validates the settings (ValueError)
-        try:
-            model.load_state_dict(released["model_state"])
-        except RuntimeError as error:
-            raise ValueError(f"{source}: {model_settings} does not fit its weights: "
-                             f"{str(error).splitlines()[0][:200]}") from None
+        model_with_weights(config, released["model_state"],
+                           f"{source}: {model_settings} does not fit its weights")
         released["model_config"] = asdict(config)
         released["release_settings"] = {**released.get("release_settings", {}),
                                          **model_settings}

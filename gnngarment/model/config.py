@@ -80,6 +80,11 @@ class ModelConfig:
     weight_prior: str = "body"
     weight_reach: float | None = 0.2
 
+    def __post_init__(self) -> None:
+        # Checked on construction, like every other config dataclass: an inconsistent
+        # model config cannot exist, whether it came from YAML, a checkpoint or code.
+        self.validate()
+
     @property
     def feature_channels(self) -> int:
         """``F``: per-joint width of the fused garment–body features."""

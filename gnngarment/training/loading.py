@@ -1,11 +1,13 @@
-"""Load a training config: the YAML file, an optional model-config file it names, and
-command-line ``key=value`` overrides — all merged strictly."""
+"""Compose a training config: the YAML file, an optional model-config file it names, and
+command-line ``key=value`` overrides — all merged strictly. Files are read by
+:func:`gnngarment.config.read_yaml` and merged by :func:`gnngarment.config.merge_config`,
+the same as every other config; only the composition lives here."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from gnngarment.config import ConfigError, load_config, merge_config
+from gnngarment.config import ConfigError, load_config, merge_config, read_yaml
 from gnngarment.model.config import ModelConfig
 from gnngarment.paths import REPOSITORY_ROOT
 from gnngarment.training.config import TrainingConfig
@@ -36,26 +38,19 @@ def load_training_config(path: str | Path, overrides: list[str] | None = None
     from omegaconf import OmegaConf
 
     path = Path(path)
-    if not path.is_file():
-        raise ConfigError(f"{path}: config file not found")
-    try:
-        raw = OmegaConf.to_container(OmegaConf.load(path), resolve=True) or {}
-    except Exception as error:
-        raise ConfigError(f"{path}: not a valid YAML file ({error})") from error
+    raw = OmegaConf.to_container(read_yaml(path), resolve=True) or {}
     if not isinstance(raw, dict):
         raise ConfigError(f"{path}: expected a mapping at the top level")
     model_file = raw.pop("model_config", None)
     if model_file:
         model_path = _resolve(str(model_file), path.parent)
         load_config(model_path, ModelConfig)  # validates the file on its own, naming it
-        from_file = OmegaConf.to_container(OmegaConf.load(model_path))
+        from_file = OmegaConf.to_container(read_yaml(model_path))
         raw["model"] = OmegaConf.to_container(OmegaConf.merge(from_file, raw.get("model") or {}))
     try:
         dotlist = OmegaConf.to_container(OmegaConf.from_dotlist(list(overrides or [])))
     except Exception as error:
         raise ConfigError(f"bad override {overrides}: {error}") from error
     source = f"{path} (with --set {' '.join(overrides)})" if overrides else str(path)
-    config = merge_config(TrainingConfig, OmegaConf.merge(OmegaConf.create(raw), dotlist),
-                          source=source)
-    config.model.validate()
-    return config
+    return merge_config(TrainingConfig, OmegaConf.merge(OmegaConf.create(raw), dotlist),
+                        source=source)
