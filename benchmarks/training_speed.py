@@ -56,7 +56,7 @@ def measure(config_path: Path, data: Path, steps: int, threads: int,
                "pairs_per_batch": config.pairs_per_batch,
                "frames_per_pair": config.frames_per_pair, "stages": {}}
     for stage in STAGES:
-        trainer.schedule.stage = stage
+        trainer.stages.stage = stage
         set_stage(trainer.model, stage)
         times, frames, vertices = [], 0, 0
         for index in range(steps + 1):

@@ -22,7 +22,7 @@ from gnngarment.model.deformer import DeformerOutput, GarmentDeformer, check_pai
 from gnngarment.training.config import TrainingConfig
 from gnngarment.training.objective import stage_loss
 from gnngarment.training.rng import rng_state, set_rng_state
-from gnngarment.training.schedule import StageSchedule
+from gnngarment.training.stage_schedule import StageSchedule
 
 CHECKPOINT_NAME = "last.pt"
 SUPERVISED_CHECKPOINT_NAME = "supervised.pt"
@@ -111,9 +111,9 @@ class Trainer:
         self.step_module: nn.Module = TrainingStep(self.model)
         self._wrapped_stage: str | None = None
         self.optimiser = torch.optim.Adamax(self.model.parameters(), lr=config.learning_rate)
-        self.scheduler = torch.optim.lr_scheduler.CosineAnnealingLR(
+        self.learning_rate_decay = torch.optim.lr_scheduler.CosineAnnealingLR(
             self.optimiser, T_max=max(config.epochs, 1))
-        self.schedule = StageSchedule(config.stages)
+        self.stages = StageSchedule(config.stages)
         self.epoch = 0
         self.global_step = 0
         self.history: list[dict[str, Any]] = []
@@ -123,21 +123,24 @@ class Trainer:
         return self.output / CHECKPOINT_NAME
 
     def state(self) -> dict[str, Any]:
+        # The keys "scheduler" (learning rate) and "schedule" (stages) are the file format
+        # of every saved training state, so they keep their names.
         return {**model_payload(self.model), "optimiser": self.optimiser.state_dict(),
-                "scheduler": self.scheduler.state_dict(), "schedule": self.schedule.state_dict(),
+                "scheduler": self.learning_rate_decay.state_dict(),
+                "schedule": self.stages.state_dict(),
                 "epoch": self.epoch, "global_step": self.global_step, "rng": rng_state(),
                 "training_config": json.dumps(asdict(self.config)),
                 "data_manifest_hash": self.train_data.manifest.get("hash", ""),
                 "history": json.dumps(self.history)}
 
     def resume(self, path: str | Path | None = None) -> None:
-        """Restore model, optimiser, scheduler, stage state, counters and RNG."""
+        """Restore model, optimiser, learning-rate decay, stage schedule, counters and RNG."""
         payload = load_checkpoint(path or self.checkpoint_path())
         self.model.load_state_dict(payload["model_state"])
-        self.schedule.load_state_dict(payload["schedule"])
-        set_stage(self.model, self.schedule.stage)
+        self.stages.load_state_dict(payload["schedule"])
+        set_stage(self.model, self.stages.stage)
         self.optimiser.load_state_dict(payload["optimiser"])
-        self.scheduler.load_state_dict(payload["scheduler"])
+        self.learning_rate_decay.load_state_dict(payload["scheduler"])
         self.epoch = int(payload["epoch"])
         self.global_step = int(payload["global_step"])
         self.history = json.loads(payload["history"])
@@ -145,7 +148,7 @@ class Trainer:
 
     # ------------------------------------------------------------------ loop
     def fit(self, resume: bool = False, stop_after: int | None = None) -> dict[str, Any]:
-        """Train until the schedule is done or ``config.epochs`` is reached.
+        """Train until the stage schedule is done or ``config.epochs`` is reached.
 
         A run folder belongs to one run: ``metrics.jsonl`` holds exactly the epochs of
         the run's checkpoint (a fresh run starts it empty; a resumed one drops the lines
@@ -180,19 +183,19 @@ class Trainer:
         last_epoch = self.config.epochs if stop_after is None else min(
             self.config.epochs, self.epoch + stop_after)
         try:
-            while self.epoch < last_epoch and self.schedule.stage != "done":
-                set_stage(self.model, self.schedule.stage)
+            while self.epoch < last_epoch and self.stages.stage != "done":
+                set_stage(self.model, self.stages.stage)
                 self._wrap_for_stage()
                 metrics = self.train_epoch()
                 if self.validation_data is not None and (
                         (self.epoch + 1) % self.config.validate_every == 0):
                     metrics |= {f"val_{k}": v for k, v in self.validate().items()}
                 self.epoch += 1
-                stage = self.schedule.stage
-                reason = self.schedule.update(metrics, self.epoch)
-                self.scheduler.step()
+                stage = self.stages.stage
+                reason = self.stages.update(metrics, self.epoch)
+                self.learning_rate_decay.step()
                 metrics |= {"epoch": self.epoch, "stage": stage,
-                            "learning_rate": self.scheduler.get_last_lr()[0]}
+                            "learning_rate": self.learning_rate_decay.get_last_lr()[0]}
                 self.history.append(metrics)
                 if self.rank == 0:
                     self._log(writer, metrics, reason)
@@ -203,18 +206,18 @@ class Trainer:
         finally:
             if writer is not None:
                 writer.close()
-        return {"epochs": self.epoch, "stage": self.schedule.stage,
-                "switches": self.schedule.switches,
+        return {"epochs": self.epoch, "stage": self.stages.stage,
+                "switches": self.stages.switches,
                 "last": self.history[-1] if self.history else {}}
 
     def _wrap_for_stage(self) -> None:
         """With several processes, (re)wrap in DDP whenever the trainable set changes:
         DDP only synchronises the parameters that required gradients when it was built."""
-        if self.world == 1 or self._wrapped_stage == self.schedule.stage:
+        if self.world == 1 or self._wrapped_stage == self.stages.stage:
             return
         self.step_module = nn.parallel.DistributedDataParallel(
             TrainingStep(self.model), find_unused_parameters=True)
-        self._wrapped_stage = self.schedule.stage
+        self._wrapped_stage = self.stages.stage
 
     def train_epoch(self) -> dict[str, float]:
         from tqdm import tqdm
@@ -230,7 +233,7 @@ class Trainer:
         sums: dict[str, float] = {}
         count = 0
         started = time.perf_counter()
-        bar = tqdm(groups, desc=f"epoch {self.epoch + 1} [{self.schedule.stage}]",
+        bar = tqdm(groups, desc=f"epoch {self.epoch + 1} [{self.stages.stage}]",
                    disable=not self.progress, leave=False, unit="batch")
         for items in bar:
             value, terms = self.step(items)
@@ -254,7 +257,7 @@ class Trainer:
         config = self.config
         batch = self.train_data.batch(items)
         output = self.step_module(batch)
-        total, terms = stage_loss(output, batch, self.schedule.stage, config.losses,
+        total, terms = stage_loss(output, batch, self.stages.stage, config.losses,
                                   config.stages, config.collision_margin)
         value = total.item()
         if not math.isfinite(value):
@@ -304,7 +307,7 @@ class Trainer:
             print(line, flush=True)
         if reason is not None:
             print(f"stage switch after epoch {self.epoch}: {metrics['stage']} -> "
-                  f"{self.schedule.stage} ({reason})", flush=True)
+                  f"{self.stages.stage} ({reason})", flush=True)
         (self.output / METRICS_NAME).parent.mkdir(parents=True, exist_ok=True)
         with open(self.output / METRICS_NAME, "a") as stream:
             stream.write(json.dumps({**metrics, "switch": reason}) + "\n")

@@ -72,7 +72,7 @@ def test_resume_continues_exactly(cache: Path, tmp_path: Path) -> None:
     for (name, a), b in zip(straight.model.state_dict().items(),
                             resumed.model.state_dict().values(), strict=True):
         assert torch.equal(a, b), name
-    assert resumed.schedule.state_dict() == straight.schedule.state_dict()
+    assert resumed.stages.state_dict() == straight.stages.state_dict()
 
 
 def test_two_runs_with_two_threads_are_bitwise_equal(cache: Path, tmp_path: Path) -> None:

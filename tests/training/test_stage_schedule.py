@@ -1,7 +1,7 @@
 from __future__ import annotations
 
 from gnngarment.training.config import StageConfig
-from gnngarment.training.schedule import StageSchedule
+from gnngarment.training.stage_schedule import StageSchedule
 
 
 def test_plateau_rule_switches_with_a_reason() -> None:
