@@ -5,7 +5,8 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from gnngarment.model.graph_attention import AttentionGraph, apply_attention, graph_attention
+from gnngarment.model.attention_graph import AttentionGraph
+from gnngarment.model.graph_attention import apply_attention, graph_attention
 
 
 class GarmentGraphEncoder(nn.Module):

@@ -11,7 +11,8 @@ import scipy.sparse as sp
 import torch
 
 from gnngarment.geometry.hierarchy import PoolHierarchy
-from gnngarment.model.graph_attention import AttentionGraph, SparseOperator
+from gnngarment.model.attention_graph import AttentionGraph
+from gnngarment.model.sparse_matrix import SparseOperator
 
 
 @dataclass

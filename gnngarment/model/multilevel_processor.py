@@ -6,7 +6,8 @@ import torch
 from torch import nn
 from torch_geometric.nn import ASAPooling, SAGPooling, TopKPooling
 
-from gnngarment.model.graph_attention import AttentionGraph, apply_attention, graph_attention
+from gnngarment.model.attention_graph import AttentionGraph
+from gnngarment.model.graph_attention import apply_attention, graph_attention
 from gnngarment.model.graph_levels import GraphLevels
 
 

@@ -8,63 +8,17 @@ from torch_geometric.nn import GATConv
 
 from gnngarment.geometry import edge_index_from_faces, pool_hierarchy
 from gnngarment.model import GarmentDeformer, MultilevelProcessor, stack_hierarchies
-from gnngarment.model.graph_attention import (
-    _MAX_SHIFT_GAP,
-    AttentionGraph,
-    GraphAttention,
-    SparseOperator,
-    _softmax_shift,
-    graph_attention,
-    set_attention,
-)
+from gnngarment.model.attention_graph import AttentionGraph
+from gnngarment.model.graph_attention import GraphAttention, graph_attention, set_attention
 from tests.meshes import random_disk, tube
+from tests.model.attention_cases import (
+    TOLERANCE,
+    assert_relative,
+    outputs_and_gradients,
+    pair_of_layers,
+    random_graph,
+)
 from tests.model.pairs import frame_inputs, make_pair, tiny_config
-
-TOLERANCE = dict(rtol=1e-5, atol=1e-6)
-
-
-def assert_relative(actual: torch.Tensor, expected: torch.Tensor, tolerance: float,
-                    name: str) -> None:
-    """``max |actual − expected| <= tolerance · max |expected|`` (normwise relative)."""
-    error = float((actual - expected).abs().max())
-    scale = float(expected.abs().max())
-    assert error <= tolerance * scale, f"{name}: {error:.2e} vs max {scale:.2e}"
-
-
-def random_graph(seed: int, num_nodes: int = 60, connected: int = 45, edges: int = 300
-                 ) -> torch.Tensor:
-    """Edges among the first ``connected`` nodes only (the rest are isolated), in two
-    components, with self loops and repeated edges (as a multigraph can have)."""
-    generator = torch.Generator().manual_seed(seed)
-    half = connected // 2
-    a = torch.randint(0, half, (2, edges // 2), generator=generator)
-    b = torch.randint(half, connected, (2, edges - edges // 2), generator=generator)
-    edge_index = torch.cat([a, b, a[:, :10]], dim=1)  # repeated edges
-    loops = torch.arange(0, connected, 7).repeat(2, 1)
-    return torch.cat([edge_index, loops], dim=1)
-
-
-def pair_of_layers(in_channels: int, out_channels: int, heads: int, concat: bool,
-                   seed: int = 0) -> tuple[GATConv, GraphAttention]:
-    torch.manual_seed(seed)
-    reference = GATConv(in_channels, out_channels, heads=heads, concat=concat)
-    torch.manual_seed(seed)
-    layer = GraphAttention(in_channels, out_channels, heads=heads, concat=concat)
-    with torch.no_grad():  # a non-zero bias, so that its gradient path is exercised too
-        reference.bias.normal_()
-        layer.bias.copy_(reference.bias)
-    return reference, layer
-
-
-def outputs_and_gradients(layer: torch.nn.Module, x: torch.Tensor, graph,
-                          weight: torch.Tensor) -> dict[str, torch.Tensor]:
-    x = x.clone().requires_grad_(True)
-    layer.zero_grad(set_to_none=True)
-    out = layer(x, graph)
-    (out * weight).sum().backward()
-    result = {"out": out.detach(), "x.grad": x.grad}
-    result.update({f"{name}.grad": p.grad for name, p in layer.named_parameters()})
-    return result
 
 
 @pytest.mark.parametrize("heads", [1, 4, 24])
@@ -89,55 +43,6 @@ def test_outputs_and_gradients_equal_gatconv(heads: int, concat: bool, prebuilt:
                                        msg=name)
         else:  # float32 sums in another order: relative to the tensor's magnitude
             assert_relative(actual[name], expected[name], 1e-5, name)
-
-
-@pytest.mark.parametrize("scale", [1.0, 10.0, 30.0])
-def test_large_logits_keep_matching(scale: float) -> None:
-    # Scaled attention vectors spread the logits far beyond the cheap shift's accepted
-    # gap (scale 10: ~35, 30: ~105): the exact segment max must then be used, and
-    # nothing may underflow or overflow. Sums of near one-hot softmaxes round
-    # differently, so compare normwise.
-    reference, layer = pair_of_layers(6, 4, 4, concat=False)
-    with torch.no_grad():
-        for module in (reference, layer):
-            module.att_src.mul_(scale)
-            module.att_dst.mul_(scale)
-    edge_index = random_graph(seed=3)
-    x = torch.randn(60, 6, generator=torch.Generator().manual_seed(4))
-    weight = torch.randn(60, 4, generator=torch.Generator().manual_seed(5))
-    expected = outputs_and_gradients(reference, x, edge_index, weight)
-    actual = outputs_and_gradients(layer, x, edge_index, weight)
-    for name in expected:
-        assert torch.isfinite(actual[name]).all(), name
-        assert_relative(actual[name], expected[name], 1e-5, name)
-
-
-@pytest.mark.parametrize("case", ["none", "bound", "exact"])
-def test_softmax_shift_keeps_exp_in_range(case: str) -> None:
-    graph = AttentionGraph.from_edge_index(random_graph(seed=8), 60)
-    layout = graph.layout(3)
-    generator = torch.Generator().manual_seed(9)
-    a_src = torch.randn(60, 3, generator=generator)
-    a_dst = torch.randn(60, 3, generator=generator)
-    if case == "bound":   # large logits of small spread: shift by the cheap bound
-        a_src += 100
-    if case == "exact":   # widely spread logits: the exact segment max is needed
-        a_src *= 100
-        a_dst *= 100
-    logits = torch.nn.functional.leaky_relu(
-        a_src.reshape(-1)[layout.source_slot.long()]
-        + a_dst.reshape(-1)[layout.target_slot.long()], 0.2)
-    exact = torch.full((180,), -torch.inf).scatter_reduce(
-        0, layout.target_slot.long(), logits, "amax")
-    shift = _softmax_shift(torch.cat([a_src, a_dst, a_src + a_dst], dim=1), 3, layout, 0.2)
-    assert (shift is None) == (case == "none")
-    if shift is None:
-        assert exact.max() <= 60 and exact.min() >= -_MAX_SHIFT_GAP
-        return
-    assert (shift >= exact).all()                      # exp never overflows
-    assert (shift - exact).max() <= _MAX_SHIFT_GAP     # denominators stay >= e^-20
-    if case == "exact":
-        torch.testing.assert_close(shift, exact, rtol=0, atol=0)
 
 
 def test_inference_mode_equals_autograd_path() -> None:
@@ -193,28 +98,6 @@ def test_block_diagonal_batch_equals_per_graph_runs() -> None:
         torch.testing.assert_close(together[o:o + n], layer(x, g), **TOLERANCE)
 
 
-def test_structure_round_trips_to_gatconv() -> None:
-    edge_index = random_graph(seed=12)
-    graph = AttentionGraph.from_edge_index(edge_index, 60)
-    assert graph.num_edges == (edge_index[0] != edge_index[1]).sum() + 60
-    reference, _ = pair_of_layers(4, 3, 2, concat=True)
-    x = torch.randn(60, 4)
-    torch.testing.assert_close(reference(x, graph.edge_index), reference(x, edge_index),
-                               **TOLERANCE)
-    assert graph.layout(2) is graph.layout(2)  # built once per head count
-
-
-def test_only_self_loops_and_bad_indices() -> None:
-    reference, layer = pair_of_layers(3, 2, 4, concat=True)
-    x = torch.randn(5, 3)
-    empty = torch.zeros(2, 0, dtype=torch.long)
-    torch.testing.assert_close(layer(x, empty), reference(x, empty), **TOLERANCE)
-    with pytest.raises(ValueError, match="outside"):
-        AttentionGraph.from_edge_index(torch.tensor([[0], [5]]), 5)
-    with pytest.raises(ValueError, match="nodes"):
-        layer(torch.randn(4, 3), AttentionGraph.from_edge_index(empty, 5))
-
-
 def test_dropout_only_in_training() -> None:
     torch.manual_seed(0)
     layer = GraphAttention(4, 3, heads=2, concat=True, dropout=0.5)
@@ -237,18 +120,6 @@ def test_bf16_autocast_keeps_attention_in_float32() -> None:
         out = layer(x, edge_index)
     assert out.dtype == torch.float32
     torch.testing.assert_close(out, reference(x, edge_index), rtol=0, atol=0.05)
-
-
-def test_sparse_operator_matches_dense_product_and_gradient() -> None:
-    generator = torch.Generator().manual_seed(15)
-    dense_matrix = torch.rand(30, 20, generator=generator) * (torch.rand(30, 20) < 0.2)
-    operator = SparseOperator(dense_matrix.to_sparse())
-    x = torch.randn(20, 6, requires_grad=True)
-    out = operator @ x
-    torch.testing.assert_close(out, dense_matrix @ x)
-    weight = torch.randn(30, 6)
-    (out * weight).sum().backward()
-    torch.testing.assert_close(x.grad, dense_matrix.t() @ weight)
 
 
 def processors_both_ways(pooling: str, levels: int) -> tuple[MultilevelProcessor,
@@ -282,31 +153,6 @@ def test_processor_equals_its_pyg_reference(pooling: str, levels: int) -> None:
         assert graph.attention_graph(0) is graph.attention_graph(0)
     if pooling == "structure" and levels:
         assert graph.unpool_operator(0) is graph.unpool_operator(0)
-
-
-def test_structures_cached_during_inference_serve_training() -> None:
-    # A context prepared for inference may later be trained on: its cached structures
-    # must not be inference tensors (autograd refuses to save those).
-    hierarchy = pool_hierarchy(edge_index_from_faces(tube(6, 9)[1], 54), 54, 2)
-    graph = stack_hierarchies([hierarchy] * 2, depth=2)
-    torch.manual_seed(0)
-    processor = MultilevelProcessor(4, 8, 2, 3, 2, 2)
-    x = torch.randn(108, 4)
-    with torch.inference_mode():
-        before = processor(x, graph)
-    x.requires_grad_(True)
-    after = processor(x, graph)
-    after.sum().backward()
-    torch.testing.assert_close(after.detach(), before, rtol=0, atol=1e-6)
-    assert x.grad is not None and x.grad.abs().sum() > 0
-
-
-def test_graph_levels_rebuild_a_replaced_level() -> None:
-    hierarchy = pool_hierarchy(edge_index_from_faces(tube(6, 9)[1], 54), 54, 1)
-    graph = stack_hierarchies([hierarchy], depth=1)
-    first = graph.attention_graph(0)
-    graph.edge_index[0] = graph.edge_index[0].clone()
-    assert graph.attention_graph(0) is not first
 
 
 def test_pyg_variant_of_the_deformer_equals_csr() -> None:
