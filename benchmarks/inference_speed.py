@@ -457,7 +457,7 @@ def child(args: argparse.Namespace) -> None:
             models[impl] = set_attention(copy.deepcopy(base), impl)  # same weights
             timer.attach(models[impl])
             tic = time.perf_counter()
-            contexts[impl] = models[impl].prepare([pair])
+            contexts[impl] = models[impl].encode([pair])
             results[impl] = {"config": args.config, "attention": impl, "vertices": len(pos),
                              "threads": threads, "weights": weights,
                              "prepare_s": time.perf_counter() - tic,

@@ -26,7 +26,7 @@ DEFAULT_BATCH_VERTICES = 10_000
 class FeatureResponse:
     """``f(X)``: a scalar output of the deformer as a function of the graph features.
 
-    Wraps :meth:`GarmentDeformer.prepare` + :meth:`GarmentDeformer.forward` for one
+    Wraps :meth:`GarmentDeformer.encode` + :meth:`GarmentDeformer.forward` for one
     garment–body pair and one frame. Everything but the features (topology, style
     descriptor, body-shape feature, motion) is held fixed. A batch of ``k`` feature
     matrices (captum's scaled inputs) runs as ``k`` copies of the pair in one
@@ -60,7 +60,7 @@ class FeatureResponse:
     def __call__(self, features: torch.Tensor) -> torch.Tensor:
         copies, n = features.shape[0], features.shape[1]
         pairs = [replace(self.pair, features=features[i]) for i in range(copies)]
-        context = self.model.prepare(pairs)
+        context = self.model.encode(pairs)
         frame = self.frame
         out = self.model(context, frame.motion_window.expand(copies, -1, -1, -1),
                          frame.velocity_window.expand(copies, -1, -1, -1),

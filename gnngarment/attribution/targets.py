@@ -22,7 +22,7 @@ def largest_output_vertex(model: GarmentDeformer, pair: GarmentBodyPair, frame: 
         with torch.no_grad():
             device = next(model.parameters()).device
             frame = frame.to(device)
-            context = model.prepare([pair])
+            context = model.encode([pair])
             out = model(context, frame.motion_window, frame.velocity_window,
                         frame.joint_transforms)
             values = (out.blend_shapes if output == "blend_shapes"

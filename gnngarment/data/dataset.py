@@ -37,7 +37,7 @@ class TrainingBatch:
     (item ``k = p·B + b``).
 
     Attributes:
-        pairs: ``P`` garment–body pairs (for :meth:`GarmentDeformer.prepare`).
+        pairs: ``P`` garment–body pairs (for :meth:`GarmentDeformer.encode`).
         motion_windows ``(P, B, m, 75)``, velocity_windows ``(P, B, m, 3 N_b')``,
         joint_transforms ``(P, B, 24, 4, 4)``: the per-frame model inputs.
         target: ``(V, 3)`` ground-truth garment vertices.

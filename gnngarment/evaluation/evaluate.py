@@ -98,7 +98,7 @@ def predict(model: GarmentDeformer, dataset: PreparedDataset, name: str,
     model.eval()
     record = dataset.sequence(name)
     garment = dataset.garment_of(name)
-    context = model.prepare([garment.pair])
+    context = model.encode([garment.pair])
     features = torch.from_numpy(record.motion_features if motion_features is None
                                 else motion_features)
     transforms = torch.from_numpy(record.joint_transforms if joint_transforms is None

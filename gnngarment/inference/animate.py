@@ -169,7 +169,7 @@ def animate(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray, body: Bo
         collision_seconds = time.perf_counter() - started
     started = time.perf_counter()
     pair = garment_pair(model, rest, faces, body, source=source)
-    context = model.prepare([pair])
+    context = model.encode([pair])
     context_seconds = time.perf_counter() - started
 
     window = model.config.window

@@ -1,7 +1,7 @@
 """The full garment deformer of the blueprint (Fig. 2): encoders, fusion, skinning
 weights, multilevel blend shapes and linear blend skinning.
 
-The work is split as the blueprint prescribes: :meth:`GarmentDeformer.prepare` runs
+The work is split as the blueprint prescribes: :meth:`GarmentDeformer.encode` runs
 the per garment–body pair part once (E^gg, E^gs, E^bs → ``X^fuse``);
 :meth:`GarmentDeformer.forward` runs the per-frame part (E^t1, E^t2, M^mp, LBS) for any
 number of frames against that context.
@@ -38,7 +38,7 @@ MOTION_CHANNELS = 3 * (NUM_JOINTS + 1)
 
 @dataclass
 class DeformerContext:
-    """Per-pair results of :meth:`GarmentDeformer.prepare`, reused for every frame.
+    """Per-pair results of :meth:`GarmentDeformer.encode`, reused for every frame.
 
     Attributes:
         fused: ``(ΣN, S, F)`` ``X^fuse`` of all pairs, concatenated along vertices.
@@ -139,13 +139,13 @@ class GarmentDeformer(nn.Module):
         self.use_physics = False
 
     # ---------------------------------------------------------------- per pair
-    def prepare(self, pairs: Sequence[GarmentBodyPair]) -> DeformerContext:
+    def encode(self, pairs: Sequence[GarmentBodyPair]) -> DeformerContext:
         """Encode garments and bodies once: ``X^fuse = X̂^gg ⊙ C^bs`` (Eq. 5).
 
         Shapes: see :class:`GarmentBodyPair`; returns ``fused (ΣN, 24, F)``.
         """
         if not pairs:
-            raise ValueError("prepare() needs at least one garment-body pair")
+            raise ValueError("encode() needs at least one garment-body pair")
         sizes = [int(pair.rest_pos.shape[0]) for pair in pairs]
         for index, pair in enumerate(pairs):
             try:
@@ -248,7 +248,7 @@ def check_pair_fits(pair: GarmentBodyPair, config: ModelConfig) -> None:
     shape) when ``pair`` does not fit a model of ``config``: wrong shapes or non-finite
     values, a descriptor of another length than ``landmarks``, body features for
     another ``body_vertices``, fewer pooling levels than the model pools, or no body
-    weights for the ``body`` prior. :meth:`GarmentDeformer.prepare` checks every pair;
+    weights for the ``body`` prior. :meth:`GarmentDeformer.encode` checks every pair;
     a trainer checks its cache's first one before any epoch."""
     n = pair.rest_pos.shape[0]
     expected = {

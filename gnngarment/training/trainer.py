@@ -35,7 +35,7 @@ class RunFolderError(ValueError):
 
 
 class TrainingStep(nn.Module):
-    """``prepare`` + ``forward`` as one module call, so DDP sees the whole computation
+    """``encode`` + ``forward`` as one module call, so DDP sees the whole computation
     (its gradient hooks cover the per-pair encoders too)."""
 
     def __init__(self, model: GarmentDeformer):
@@ -43,7 +43,7 @@ class TrainingStep(nn.Module):
         self.model = model
 
     def forward(self, batch: TrainingBatch) -> DeformerOutput:
-        context = self.model.prepare(batch.pairs)
+        context = self.model.encode(batch.pairs)
         return self.model(context, batch.motion_windows, batch.velocity_windows,
                           batch.joint_transforms)
 

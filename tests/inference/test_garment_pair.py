@@ -34,7 +34,7 @@ def test_body_prior_pairs_carry_the_transferred_body_weights() -> None:
     pair = garment_pair(model, pos, faces, body)
     expected = transfer_body_weights(pos, body.rest_vertices, body.skinning_weights)
     np.testing.assert_allclose(pair.body_weights.numpy(), expected)
-    model.prepare([pair])  # accepted as it is
+    model.encode([pair])  # accepted as it is
     with pytest.raises(ValueError, match="skinning weights"):
         garment_pair(model, pos, faces, body_shape(model.config, skinning=False))
 
@@ -44,4 +44,4 @@ def test_models_without_the_prior_need_no_body_weights() -> None:
     model = GarmentDeformer(replace(tiny_config(), weight_prior="none"))
     pair = garment_pair(model, pos, faces, body_shape(model.config, skinning=False))
     assert pair.body_weights is None
-    assert torch.isfinite(model.prepare([pair]).fused).all()
+    assert torch.isfinite(model.encode([pair]).fused).all()

@@ -24,7 +24,7 @@ def build(config: ModelConfig, seed: int = 0) -> GarmentDeformer:
 
 
 def run(model, pairs, frames=2, seed=0):
-    context = model.prepare(pairs)
+    context = model.encode(pairs)
     return model(context, *frame_inputs(model.config, len(pairs), frames, seed))
 
 
@@ -49,7 +49,7 @@ def test_identity_transforms_give_rest_plus_blend_shapes(garments) -> None:
     config = tiny_config()
     model = build(config)
     pair = make_pair(*garments["disk"], config)
-    context = model.prepare([pair])
+    context = model.encode([pair])
     motion, velocity, _ = frame_inputs(config, 1, 2)
     out = model(context, motion, velocity, torch.eye(4).repeat(1, 2, 24, 1, 1))
     torch.testing.assert_close(out.posed, pair.rest_pos.repeat(2, 1) + out.blend_shapes)
@@ -78,10 +78,10 @@ def test_a_batch_of_two_garments_equals_one_by_one(garments) -> None:
     pairs = [make_pair(*garments["disk"], config, seed=1),
              make_pair(*garments["tube"], config, seed=2)]
     motion, velocity, transforms = frame_inputs(config, 2, 3, seed=5)
-    together = model(model.prepare(pairs), motion, velocity, transforms)
+    together = model(model.encode(pairs), motion, velocity, transforms)
     sizes = [150, 80]
     for p, pair in enumerate(pairs):
-        alone = model(model.prepare([pair]), motion[p:p + 1], velocity[p:p + 1],
+        alone = model(model.encode([pair]), motion[p:p + 1], velocity[p:p + 1],
                       transforms[p:p + 1])
         for name in ("weights", "blend_shapes", "posed"):
             torch.testing.assert_close(together.split(name, sizes, 3)[p],
@@ -186,10 +186,10 @@ def test_bad_inputs_name_the_field(garments) -> None:
     model = build(config)
     pair = make_pair(*garments["disk"], config)
     with pytest.raises(ValueError, match="descriptor has shape"):
-        model.prepare([replace(pair, descriptor=torch.zeros(5))])
+        model.encode([replace(pair, descriptor=torch.zeros(5))])
     with pytest.raises(ValueError, match="features contains NaN"):
-        model.prepare([replace(pair, features=pair.features.clone().fill_(float("nan")))])
-    context = model.prepare([pair])
+        model.encode([replace(pair, features=pair.features.clone().fill_(float("nan")))])
+    context = model.encode([pair])
     motion, velocity, transforms = frame_inputs(config, 1, 2)
     with pytest.raises(ValueError, match="velocity_windows"):
         model(context, motion, velocity[..., :-1], transforms)

@@ -169,7 +169,7 @@ def test_pyg_variant_of_the_deformer_equals_csr() -> None:
         assert layers and all(isinstance(m, kind) for m in layers)
         model.use_physics = True
         pair = make_pair(pos, faces, config)
-        out = model(model.prepare([pair]), *frame_inputs(config, 1, 2))
+        out = model(model.encode([pair]), *frame_inputs(config, 1, 2))
         out.posed.sum().backward()
         outputs[attention] = out
     for name in ("weights", "blend_shapes", "posed"):

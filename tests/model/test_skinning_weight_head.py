@@ -39,7 +39,7 @@ def test_untrained_body_prior_is_body_skinning(garment) -> None:
     pair = make_pair(*garment, model.config)
     pair.body_weights[:5] = torch.eye(24)[:5]  # exact zeros meet the floor
     motion, velocity, transforms = frame_inputs(model.config, 1, 3, seed=2)
-    out = model(model.prepare([pair]), motion, velocity, transforms)
+    out = model(model.encode([pair]), motion, velocity, transforms)
 
     expected = floored(pair.body_weights).repeat(3, 1)
     torch.testing.assert_close(out.weights, expected, atol=1e-5, rtol=0)
@@ -58,7 +58,7 @@ def test_untrained_head_with_a_reach_is_body_skinning_on_the_reachable_joints(ga
     model = build()
     assert model.config.weight_reach == 0.2
     pair = make_pair(*garment, model.config)
-    out = model(model.prepare([pair]), *frame_inputs(model.config, 1, 2))
+    out = model(model.encode([pair]), *frame_inputs(model.config, 1, 2))
     kept = floored(pair.body_weights) * reachable_joints(pair.rest_pos, pair.body_weights, 0.2)
     expected = (kept / kept.sum(-1, keepdim=True)).repeat(2, 1)
     torch.testing.assert_close(out.weights, expected, atol=1e-6, rtol=0)
@@ -68,7 +68,7 @@ def test_body_prior_is_per_pair_in_a_batch(garment) -> None:
     model = build(weight_reach=None)
     pairs = [make_pair(*garment, model.config, seed=1), make_pair(*tube(6, 8), model.config,
                                                                 seed=2)]
-    out = model(model.prepare(pairs), *frame_inputs(model.config, 2, 2))
+    out = model(model.encode(pairs), *frame_inputs(model.config, 2, 2))
     for p, part in enumerate(out.split("weights", [120, 48], 2)):
         torch.testing.assert_close(part, floored(pairs[p].body_weights).expand(2, -1, -1),
                                    atol=1e-5, rtol=0)
@@ -81,13 +81,13 @@ def test_no_prior_is_the_plain_softmax_head(garment) -> None:
     assert not any("weight_head" in name for name, _ in model.named_parameters())
     pair = make_pair(*garment, model.config)
     motion, velocity, transforms = frame_inputs(model.config, 1, 2)
-    context = model.prepare([pair])
+    context = model.encode([pair])
     assert context.prior_logits is None
     out = model(context, motion, velocity, transforms)
     pose_code, _ = model.pose_encoder(motion.flatten(0, 1))
     expected = torch.softmax(torch.einsum("nsf,bf->bns", context.fused, pose_code), -1)
     torch.testing.assert_close(out.weights, expected.flatten(0, 1))
-    without = model(model.prepare([replace(pair, body_weights=None)]), motion, velocity,
+    without = model(model.encode([replace(pair, body_weights=None)]), motion, velocity,
                     transforms)
     assert torch.equal(out.posed, without.posed)
 
@@ -99,7 +99,7 @@ def test_gradients_reach_the_gate_and_then_everything(garment) -> None:
     inputs = frame_inputs(model.config, 1, 2)
     target = torch.randn(2 * 120, 3)
 
-    out = model(model.prepare([pair]), *inputs)
+    out = model(model.encode([pair]), *inputs)
     ((out.posed - target) ** 2).mean().backward()
     gate = model.weight_head.gate
     assert gate is not None and gate.grad is not None and gate.grad.abs() > 0
@@ -113,7 +113,7 @@ def test_gradients_reach_the_gate_and_then_everything(garment) -> None:
     optimiser = torch.optim.Adamax(model.parameters(), lr=1e-2)
     optimiser.step()
     optimiser.zero_grad(set_to_none=True)
-    out = model(model.prepare([pair]), *inputs)
+    out = model(model.encode([pair]), *inputs)
     ((out.posed - target) ** 2).mean().backward()
     assert gate.item() != 0
     for name, parameter in model.named_parameters():
@@ -144,7 +144,7 @@ def test_body_prior_needs_body_weights(garment, body_weights, message: str) -> N
     model = build()
     pair = replace(make_pair(*garment, model.config), body_weights=body_weights)
     with pytest.raises(ValueError, match=message):
-        model.prepare([pair])
+        model.encode([pair])
 
 
 def test_unknown_prior_is_rejected() -> None:
@@ -164,8 +164,8 @@ def test_checkpoints_keep_their_prior(garment, tmp_path) -> None:
     assert loaded.config.weight_prior == "none" and loaded.config.weight_reach is None
     pair = make_pair(*garment, old.config)
     inputs = frame_inputs(old.config, 1, 2)
-    assert torch.equal(old(old.prepare([pair]), *inputs).posed,
-                       loaded(loaded.prepare([pair]), *inputs).posed)
+    assert torch.equal(old(old.encode([pair]), *inputs).posed,
+                       loaded(loaded.encode([pair]), *inputs).posed)
 
     new = build(seed=3)
     with torch.no_grad():
@@ -190,7 +190,7 @@ def test_weight_reach_gives_far_joints_no_weight(garment) -> None:
     for reach, model in models.items():
         with torch.no_grad():
             model.weight_head.gate.fill_(5.0)
-        weights = model(model.prepare([pair]), *inputs).weights
+        weights = model(model.encode([pair]), *inputs).weights
         torch.testing.assert_close(weights.sum(-1), torch.ones(len(weights)))
         if reach is None:
             assert weights[far].max() > 1e-3
