@@ -439,12 +439,12 @@ def _hold_output_folder(context: typer.Context, out: Path):
     or by the kernel if it is killed). A second ``animate`` into the same folder is
     refused at once, naming the holder, instead of both running and mixing their frames;
     a folder that cannot be created or written is reported before the inference."""
-    from gnngarment.inference.output_folder import check_output_folder
+    from gnngarment.inference.output_folder import check_writable_folder
     from gnngarment.io.atomic import FolderLock
 
     try:
-        check_output_folder(out)  # says why (a file, a place that cannot be written)
-        return context.with_resource(FolderLock(out, "export"))
+        check_writable_folder(out)  # says why (a file, a place that cannot be written)
+        return context.with_resource(FolderLock(out, "export"))  # or who holds it
     except OSError as error:
         raise fail(f"--out {out}: {error}") from None
 

@@ -14,11 +14,27 @@ def check_output_folder(out: str | Path, what: str = "export") -> None:
     it, and no other ``what`` holds its :class:`FolderLock`.
 
     Creates nothing and leaves nothing behind (a refused run must not leave an empty
-    folder or a lock file): the run makes the folder when it writes.
+    folder or a lock file): the run makes the folder when it writes. A run that takes
+    the lock itself at once needs only :func:`check_writable_folder`.
 
     Raises:
         OSError: why not (:class:`~gnngarment.io.atomic.FolderBusyError` when
             another run holds the folder).
+    """
+    out = Path(out)
+    check_writable_folder(out)
+    if (out / ".lock").is_file():
+        # Only a folder with a lock file can be held; taking it rewrites only that file.
+        with FolderLock(out, what):
+            pass
+
+
+def check_writable_folder(out: str | Path) -> None:
+    """``out`` is a folder or can be made one, and files can be written in it; creates
+    nothing and leaves nothing behind.
+
+    Raises:
+        OSError: why not (a file in the way, no permission).
     """
     out = Path(out)
     existing = out
@@ -31,7 +47,3 @@ def check_output_folder(out: str | Path, what: str = "export") -> None:
         os.rmdir(tempfile.mkdtemp(prefix=".probe-", dir=existing))
     except OSError as error:
         raise PermissionError(f"cannot write in {existing} ({error.strerror})") from None
-    if existing == out and (out / ".lock").is_file():
-        # Only a folder with a lock file can be held; taking it rewrites only that file.
-        with FolderLock(out, what):
-            pass
