@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
+from gnngarment.attribution.errors import AttributionArgumentError
 from gnngarment.body.skeleton import NUM_JOINTS
 from gnngarment.data.body_inputs import BodyMotionInputs
 from gnngarment.model.config import ModelConfig
@@ -53,8 +54,9 @@ class FrameInputs:
 
         total = frames.motion_features.shape[0]
         if not 0 <= index < total:
-            raise ValueError(f"frame index {index} is out of range for a motion of {total} "
-                             f"frames (expected 0..{total - 1})")
+            raise AttributionArgumentError(
+                "frame_index", f"frame index {index} is out of range for a motion of "
+                f"{total} frames (expected 0..{total - 1})")
         if window < 1:
             raise ValueError(f"window must be >= 1, got {window}")
         rows = window_indices(np.array([index]), window)[0]                     # (m,)

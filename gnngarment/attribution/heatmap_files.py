@@ -13,6 +13,7 @@ import numpy as np
 
 from gnngarment.attribution.attribution import HEAT_CHANNELS, OUTPUTS, TARGET_KINDS
 from gnngarment.attribution.colors import SCALES
+from gnngarment.attribution.errors import AttributionArgumentError
 from gnngarment.attribution.frame_inputs import FrameInputs
 from gnngarment.attribution.influence_field import influence_field
 from gnngarment.attribution.integrated_gradients import attribute
@@ -74,21 +75,24 @@ def run_attribution(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,
     chosen: np.ndarray | int | None = None
     if target == "vertex":
         if vertices and len(vertices) != 1:
-            raise ValueError(f"target 'vertex' takes one vertex, got {len(vertices)}")
+            raise AttributionArgumentError(
+                "vertices", f"target 'vertex' takes one vertex, got {len(vertices)}")
         chosen = (vertices[0] if vertices
                   else largest_output_vertex(model, pair, frame, output))
     elif target == "region":
         if not vertices:
-            raise ValueError("target 'region' needs vertices (the region, or its centres "
-                             "with a radius)")
+            raise AttributionArgumentError(
+                "vertices", "target 'region' needs vertices (the region, or its centres "
+                "with a radius)")
         chosen = np.asarray(vertices, dtype=np.int64)
         if radius is not None:
             if chosen.min() < 0 or chosen.max() >= len(pos):
-                raise ValueError(f"region centre out of range for a garment of {len(pos)} "
-                                 f"vertices (expected 0..{len(pos) - 1})")
+                raise AttributionArgumentError(
+                    "vertices", f"region centre out of range for a garment of {len(pos)} "
+                    f"vertices (expected 0..{len(pos) - 1})")
             chosen = geodesic_region(pos, edge_index, chosen, radius)
     elif vertices:
-        raise ValueError("target 'all' takes no vertices")
+        raise AttributionArgumentError("vertices", "target 'all' takes no vertices")
 
     result = attribute(model, pair, frame, target=target, target_vertices=chosen,
                        output=output, reduction=reduction, n_steps=n_steps)

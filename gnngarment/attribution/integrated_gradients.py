@@ -11,6 +11,7 @@ import numpy as np
 import torch
 
 from gnngarment.attribution.attribution import OUTPUTS, REDUCTIONS, TARGET_KINDS, Attribution
+from gnngarment.attribution.errors import AttributionArgumentError
 from gnngarment.attribution.frame_inputs import FrameInputs
 from gnngarment.data.pair import GarmentBodyPair
 from gnngarment.data.vertex_features import VERTEX_FEATURE_CHANNELS
@@ -172,7 +173,8 @@ def _target_vertices(target: str, target_vertices: int | Sequence[int] | np.ndar
         raise ValueError(f"unknown target kind '{target}' (expected one of {TARGET_KINDS})")
     if target == "all":
         if target_vertices is not None:
-            raise ValueError("target 'all' takes no target_vertices (it uses every vertex)")
+            raise AttributionArgumentError(
+                "target_vertices", "target 'all' takes no target_vertices (it uses every vertex)")
         return np.arange(n, dtype=np.int64)
     if target_vertices is None:
         raise ValueError(f"target '{target}' needs target_vertices")
@@ -181,12 +183,14 @@ def _target_vertices(target: str, target_vertices: int | Sequence[int] | np.ndar
         raise ValueError(f"target_vertices must be integer vertex indices, got "
                          f"{np.asarray(target_vertices)!r}")
     if target == "vertex" and indices.size != 1:
-        raise ValueError(f"target 'vertex' takes exactly one vertex, got {indices.size} "
-                         "(use target='region' for several)")
+        raise AttributionArgumentError(
+            "target_vertices", f"target 'vertex' takes exactly one vertex, got {indices.size} "
+            "(use target='region' for several)")
     bad = indices[(indices < 0) | (indices >= n)]
     if bad.size:
-        raise ValueError(f"target vertex {int(bad[0])} is out of range for a garment of {n} "
-                         f"vertices (expected 0..{n - 1})")
+        raise AttributionArgumentError(
+            "target_vertices", f"target vertex {int(bad[0])} is out of range for a garment "
+            f"of {n} vertices (expected 0..{n - 1})")
     if np.unique(indices).size != indices.size:
         raise ValueError("target_vertices contains duplicates")
     return indices.astype(np.int64)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
+from gnngarment.attribution.errors import AttributionArgumentError
 from gnngarment.attribution.frame_inputs import FrameInputs
 from gnngarment.data.pair import GarmentBodyPair
 from gnngarment.geometry.geodesics import geodesic_distances
@@ -41,7 +42,7 @@ def geodesic_region(pos: np.ndarray, edge_index: np.ndarray, centres: int | np.n
         ValueError: negative ``radius`` or a centre out of range.
     """
     if not radius >= 0.0:
-        raise ValueError(f"radius must be >= 0 metres, got {radius}")
+        raise AttributionArgumentError("radius", f"radius must be >= 0 metres, got {radius}")
     centres = np.atleast_1d(np.asarray(centres, dtype=np.int64))
     distances = geodesic_distances(pos, edge_index, centres).min(axis=0)
     return np.flatnonzero(distances <= radius).astype(np.int64)

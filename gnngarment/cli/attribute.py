@@ -15,10 +15,9 @@ from gnngarment.cli.errors import check_motion_options, fail, refuse_misplaced_g
 
 #: The option a problem found by :func:`run_attribution` comes from (its messages name
 #: its own arguments: the frame index, the target vertices, the radius).
-OPTION_OF_PROBLEM = (("frame index", "--frame"), ("target vertex", "--vertex"),
-                     ("region centre", "--vertex"), ("target 'vertex' takes", "--vertex"),
-                     ("target 'region' needs", "--vertex"), ("target 'all' takes", "--vertex"),
-                     ("radius", "--radius"))
+#: The option of each attribution argument an AttributionArgumentError may name.
+OPTION_OF_ARGUMENT = {"frame_index": "--frame", "vertices": "--vertex",
+                      "target_vertices": "--vertex", "radius": "--radius"}
 
 
 def attribute_command(
@@ -140,8 +139,10 @@ def attribute_command(
                 target=target, vertices=vertex or None, radius=radius, output=output,
                 n_steps=n_steps, heat=heat, scale=scale, source=str(garment_mesh))
     except (ValueError, MeshError) as error:
-        option = next((name for start, name in OPTION_OF_PROBLEM
-                       if str(error).startswith(start)), None)
+        from gnngarment.attribution.errors import AttributionArgumentError
+
+        option = (OPTION_OF_ARGUMENT.get(error.argument)
+                  if isinstance(error, AttributionArgumentError) else None)
         raise fail(f"{option}: {error}" if option else str(error)) from None
     console.print(
         f"{summary['target']} {summary['output']}: f(X) = {summary['value']:.4g}, "
