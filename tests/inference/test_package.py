@@ -1,8 +1,7 @@
 """The package's lazy exports (issue 16: ``gnngarment.inference.Animation`` recursed and
 ``animate`` named the module once it was loaded)."""
 
-import subprocess
-import sys
+from tests.fresh_interpreter import run_in_fresh_interpreter
 
 
 def test_lazy_exports_are_the_objects_in_a_fresh_interpreter() -> None:
@@ -12,5 +11,4 @@ def test_lazy_exports_are_the_objects_in_a_fresh_interpreter() -> None:
             "assert inspect.isfunction(package.garment_pair)\n"
             "from gnngarment.inference.animate import animate\n"
             "assert package.animate is animate\n")
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert result.returncode == 0, result.stderr[-2000:]
+    run_in_fresh_interpreter(code)

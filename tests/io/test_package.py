@@ -1,7 +1,6 @@
 """``gnngarment.io`` sits below every other package: it imports nothing else of ours."""
 
-import subprocess
-import sys
+from tests.fresh_interpreter import run_in_fresh_interpreter
 
 
 def test_io_modules_load_only_numpy_and_themselves() -> None:
@@ -12,5 +11,4 @@ def test_io_modules_load_only_numpy_and_themselves() -> None:
             "and m != 'gnngarment' and not m.startswith('gnngarment.io'))\n"
             "assert not ours, ours\n"
             "assert 'torch' not in sys.modules and 'scipy' not in sys.modules\n")
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert result.returncode == 0, result.stderr[-2000:]
+    run_in_fresh_interpreter(code)

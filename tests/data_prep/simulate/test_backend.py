@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
+from tests.fresh_interpreter import run_in_fresh_interpreter
 
 
 def test_importing_the_package_loads_neither_warp_nor_newton() -> None:
     code = ("import sys, data_prep.simulate; "
             "print(sorted(m for m in ('warp', 'newton') if m in sys.modules))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True)
-    assert out.stdout.strip() == "[]"
+    assert run_in_fresh_interpreter(code).strip() == "[]"
