@@ -22,6 +22,8 @@ def garment_vertex_features(pos: np.ndarray, faces: np.ndarray,
     """
     pos = np.asarray(pos, dtype=np.float64)
     joints = np.asarray(joints, dtype=np.float64)
+    if pos.ndim != 2 or pos.shape[1] != 3:
+        raise ValueError(f"pos must have shape (N, 3), got {pos.shape}")
     if joints.shape != (24, 3):
         raise ValueError(f"joints must have shape (24, 3), got {joints.shape}")
     features = np.concatenate(
