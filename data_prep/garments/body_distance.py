@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from data_prep.garments.angles import corner_angles
 from gnngarment.geometry.normals import face_normals
 
 
@@ -112,17 +113,12 @@ class _Component:
     def __init__(self, vertices: np.ndarray, faces: np.ndarray) -> None:
         self.vertices = vertices
         self.faces = faces
-        corners = vertices[faces]
         normals = self.face_normals = face_normals(vertices, faces)
         # Angle-weighted vertex pseudo-normals.
         vertex_normals = np.zeros_like(vertices)
+        angles = corner_angles(vertices, faces)
         for k in range(3):
-            u = corners[:, (k + 1) % 3] - corners[:, k]
-            v = corners[:, (k + 2) % 3] - corners[:, k]
-            cos = np.einsum("ij,ij->i", u, v) / np.maximum(
-                np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1), 1e-300)
-            angle = np.arccos(np.clip(cos, -1, 1))
-            np.add.at(vertex_normals, faces[:, k], normals * angle[:, None])
+            np.add.at(vertex_normals, faces[:, k], normals * angles[:, k, None])
         self.vertex_normals = vertex_normals
         # Edge pseudo-normals: sum of the two faces' normals, looked up per (face, edge).
         pairs = np.stack([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]], axis=1)

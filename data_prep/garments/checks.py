@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.spatial import cKDTree
 
+from data_prep.garments.angles import corner_angles
+
 if TYPE_CHECKING:
     from data_prep.garments.body_frame import BodyFrame
     from data_prep.garments.garment import Garment
@@ -72,15 +74,7 @@ def self_intersections(pos: np.ndarray, faces: np.ndarray, chunk: int = 200_000)
 
 def min_angles_deg(pos: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """``(F,)`` smallest interior angle of each triangle, degrees."""
-    corners = pos[faces]
-    angles = []
-    for k in range(3):
-        u = corners[:, (k + 1) % 3] - corners[:, k]
-        v = corners[:, (k + 2) % 3] - corners[:, k]
-        cos = np.einsum("ij,ij->i", u, v) / np.maximum(
-            np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1), 1e-300)
-        angles.append(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
-    return np.min(angles, axis=0)
+    return np.degrees(corner_angles(pos, faces)).min(axis=1)
 
 
 def garment_problems(garment: Garment, body: BodyFrame, expected_openings: int | None = None,

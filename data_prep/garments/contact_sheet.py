@@ -108,7 +108,9 @@ def pipeline_figure(body: BodyFrame, path: Path, seed: int = 4) -> None:
     import matplotlib.pyplot as plt
 
     from data_prep.garments import mesher
-    from data_prep.garments.pattern import pair, silhouette, trace
+    from data_prep.garments.panel_boundary import trace
+    from data_prep.garments.pattern import pair
+    from data_prep.garments.silhouette import silhouette
     from data_prep.garments.tshirt import TShirtStyle, tshirt_outline
 
     design = tshirt_outline(body, TShirtStyle(sleeve_length=0.45, neckline="v",

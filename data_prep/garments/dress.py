@@ -7,10 +7,16 @@ from typing import ClassVar
 
 from data_prep.garments.body_frame import BodyFrame
 from data_prep.garments.outline import GarmentOutline
-from data_prep.garments.parts import bounds, hem_cut, hem_low, trunk_stack, upper_parts
+from data_prep.garments.parts import (
+    NECKLINES,
+    bounds,
+    hem_cut,
+    hem_low,
+    styled_upper_parts,
+    trunk_stack,
+)
 from data_prep.garments.shapes import Design
 from data_prep.garments.style import Style, choice, number
-from data_prep.garments.tshirt import NECKLINES
 
 
 @dataclasses.dataclass(frozen=True)
@@ -42,11 +48,8 @@ def dress_outline(body: BodyFrame, style: DressStyle) -> GarmentOutline:
     z_hem = (m.z_crotch - 0.06) - style.length * (m.z_crotch - 0.06 - (m.z_ankle + 0.06))
     torso = trunk_stack(m, z_hem - 0.1, float(m.shoulder_z.max()) + 0.1, style.looseness,
                         skirt_from=m.z_hip, flare=style.flare, vertices=body.vertices)
-    extra, cuts, loops, top = upper_parts(
-        body.vertices, m, torso, sleeves=style.sleeves, sleeve_length=style.sleeve_length,
-        sleeve_looseness=style.sleeve_looseness, sleeve_flare=0.0, neckline=style.neckline,
-        neck_depth=style.neck_depth, back_depth=style.back_depth, neck_width=style.neck_width,
-        strap=style.strap, armhole_drop=style.armhole_drop, top_edge=style.top_edge)
+    extra, cuts, loops, top = styled_upper_parts(body.vertices, m, torso, style,
+                                                 sleeve_flare=0.0)
     solids = [torso, *extra]
     hem = hem_cut(z_hem, torso, front_rise=style.front_rise)
     design = Design(solids=solids, cuts=[hem, *cuts],

@@ -13,12 +13,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from data_prep.garments.angles import vector_angles
+
 
 def _angle(pos: np.ndarray, apex: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    u, v = pos[a] - pos[apex], pos[b] - pos[apex]
-    cos = np.einsum("ij,ij->i", u, v) / np.maximum(
-        np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1), 1e-300)
-    return np.arccos(np.clip(cos, -1.0, 1.0))
+    """``(E,)`` angle at ``pos[apex]`` between ``pos[a]`` and ``pos[b]``, radians."""
+    return vector_angles(pos[a] - pos[apex], pos[b] - pos[apex])
 
 
 def _normal(pos: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:

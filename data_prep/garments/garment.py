@@ -16,11 +16,11 @@ import numpy as np
 
 from data_prep.garments.body_frame import BodyFrame
 from data_prep.garments.dress import DressStyle, dress_outline
+from data_prep.garments.errors import PatternError
 from data_prep.garments.jumpsuit import JumpsuitStyle, jumpsuit_outline
 from data_prep.garments.mesher import mesh_design
 from data_prep.garments.outline import GarmentOutline
 from data_prep.garments.parts import CLEARANCE
-from data_prep.garments.pattern import PatternError
 from data_prep.garments.skirt import SkirtStyle, skirt_outline
 from data_prep.garments.style import Style
 from data_prep.garments.top import TopStyle, top_outline

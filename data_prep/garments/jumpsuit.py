@@ -7,11 +7,18 @@ from typing import ClassVar
 
 from data_prep.garments.body_frame import BodyFrame
 from data_prep.garments.outline import GarmentOutline
-from data_prep.garments.parts import LEG_BLEND, bounds, hem_cut, trunk_stack, upper_parts
+from data_prep.garments.parts import (
+    LEG_BLEND,
+    NECKLINES,
+    SEAT_BLEND,
+    bounds,
+    hem_cut,
+    styled_upper_parts,
+    trunk_stack,
+)
 from data_prep.garments.shapes import Design, Group
 from data_prep.garments.style import Style, choice, number
 from data_prep.garments.trousers import leg_parts
-from data_prep.garments.tshirt import NECKLINES
 
 
 @dataclasses.dataclass(frozen=True)
@@ -42,20 +49,15 @@ class JumpsuitStyle(Style):
 
 def jumpsuit_outline(body: BodyFrame, style: JumpsuitStyle) -> GarmentOutline:
     m = body.measurements
-    top_of_hem = m.z_crotch - 0.04
-    z_hem = top_of_hem - style.length * (top_of_hem - (m.z_ankle + 0.03))
     z_crotch = m.z_crotch - style.crotch_drop
     torso = trunk_stack(m, z_crotch - 0.05, float(m.shoulder_z.max()) + 0.1, style.looseness,
                         bottom=z_crotch)
-    legs, z_hem = leg_parts(m, torso, z_hem, style.leg_looseness, style.flare, style.flare_from)
-    extra, cuts, loops, top = upper_parts(
-        body.vertices, m, torso, sleeves=style.sleeves, sleeve_length=style.sleeve_length,
-        sleeve_looseness=style.sleeve_looseness, sleeve_flare=0.0, neckline=style.neckline,
-        neck_depth=style.neck_depth, back_depth=style.back_depth, neck_width=style.neck_width,
-        strap=style.strap, armhole_drop=style.armhole_drop, top_edge=style.top_edge)
+    legs, z_hem = leg_parts(m, torso, style.length, style.leg_looseness, style.flare,
+                            style.flare_from)
+    extra, cuts, loops, top = styled_upper_parts(body.vertices, m, torso, style,
+                                                 sleeve_flare=0.0)
     solids = [torso, Group(tuple(legs), blend=LEG_BLEND), *extra]
-    # A wide blend: the seat runs smoothly into the thighs (the legs are one hard union,
-    # so the blend never bridges the gap between them).
-    design = Design(solids=solids, blend=0.07, cuts=[hem_cut(z_hem, legs[0], name="leg"), *cuts],
+    design = Design(solids=solids, blend=SEAT_BLEND,
+                    cuts=[hem_cut(z_hem, legs[0], name="leg"), *cuts],
                     bounds=bounds(solids, z_hem, float(m.shoulder_z.max()) + 0.15))
     return GarmentOutline(design=design, loops=loops + 2, top=top)

@@ -23,37 +23,11 @@ import dataclasses
 import numpy as np
 
 from data_prep.garments.body_frame import BodyFrame
+from data_prep.garments.shapes import Sections
 
 TRUNK, HEAD, ARM_L, ARM_R = 0, 1, 2, 3
 SLAB = 0.01  # metres: the height resolution of the sections
 EXPONENTS = np.array([2.0, 2.5, 3.0, 4.0, 6.0])
-
-
-@dataclasses.dataclass
-class Sections:
-    """Superelliptic sections at heights ``z`` (all ``(K,)``, metres): centre ``(cx, cy)``,
-    half-width ``a``, front depth ``bf``, back depth ``bb``, exponent ``p``."""
-
-    z: np.ndarray
-    cx: np.ndarray
-    cy: np.ndarray
-    a: np.ndarray
-    bf: np.ndarray
-    bb: np.ndarray
-    p: np.ndarray
-
-    def at(self, z: float) -> dict[str, float]:
-        """The section interpolated at one height."""
-        return {name: float(np.interp(z, self.z, getattr(self, name)))
-                for name in ("cx", "cy", "a", "bf", "bb", "p")}
-
-    def between(self, low: float, high: float) -> Sections:
-        """The sections with ``low <= z <= high`` (at least the two nearest)."""
-        keep = (self.z >= low) & (self.z <= high)
-        if keep.sum() < 2:
-            keep = np.argsort(np.abs(self.z - (low + high) / 2))[:2]
-            keep = np.sort(keep)
-        return Sections(*(getattr(self, f.name)[keep] for f in dataclasses.fields(self)))
 
 
 @dataclasses.dataclass

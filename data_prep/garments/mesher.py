@@ -1,6 +1,7 @@
 """From an implicit design to a clean triangle mesh around the body.
 
-1. :mod:`.pattern` turns the design into stitched front/back panels (the topology and
+1. :mod:`.pattern` (with :mod:`.silhouette`, :mod:`.panel_boundary`,
+   :mod:`.panel_triangulation`) turns the design into stitched front/back panels (the topology and
    a first placement: each panel point is lifted along Y onto the design's surface).
 2. :func:`relax` evens the mesh out on that surface: tangential umbrella smoothing,
    then a Newton step back onto the surface; opening vertices slide along their loop
@@ -19,21 +20,14 @@ import numpy as np
 import scipy.sparse as sp
 
 from data_prep.garments.body_distance import BodyDistance
+from data_prep.garments.errors import PatternError
 from data_prep.garments.flips import delaunay_flips
-from data_prep.garments.pattern import (
-    PanelMesh,
-    Pattern,
-    PatternError,
-    Silhouette,
-    lift_on_grid,
-    pair,
-    resample,
-    silhouette,
-    surface_area,
-    trace,
-    triangulate,
-)
+from data_prep.garments.panel_boundary import trace
+from data_prep.garments.panel_triangulation import triangulate
+from data_prep.garments.pattern import Pattern, pair, resample
 from data_prep.garments.shapes import Design, gradient
+from data_prep.garments.silhouette import Silhouette, lift_on_grid, silhouette, surface_area
+from data_prep.garments.stitching import PanelMesh
 from gnngarment.geometry.boundary import boundary_loops as geometry_boundary_loops
 
 MAX_STEP = 0.02  # metres: largest Newton step onto the surface (no jumps across gaps)

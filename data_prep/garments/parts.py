@@ -10,16 +10,19 @@ All lengths in metres, Z up, the body facing −Y.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
-from data_prep.garments.measurements import TRUNK, BodyMeasurements, Sections
-from data_prep.garments.pattern import PatternError
+from data_prep.garments.errors import PatternError
+from data_prep.garments.measurements import TRUNK, BodyMeasurements
 from data_prep.garments.shapes import (
     Cut,
     DiskCut,
     EllipseCut,
     Group,
     PlaneCut,
+    Sections,
     Solid,
     Stack,
     Tube,
@@ -27,10 +30,14 @@ from data_prep.garments.shapes import (
     VCut,
 )
 
+if TYPE_CHECKING:
+    from data_prep.garments.style import Style
+
 CLEARANCE = 0.01  # metres: least distance of any garment vertex from the body
 MIN_STRAP = 0.025  # metres: narrowest shoulder strap of a sleeveless garment
 MAX_FLARE = 0.45  # metres: most a skirt's hem reaches beyond the body's hips
 SKIRT_EXPONENT = 2.5  # superellipse exponent a skirt's section turns to below the hips
+NECKLINES = ("round", "v", "boat", "square")  # the shapes :func:`neck_cut` makes
 
 
 def _cumulative_max_down(values: np.ndarray, z: np.ndarray, below: float) -> np.ndarray:
@@ -95,6 +102,18 @@ def trunk_stack(m: BodyMeasurements, z_low: float, z_high: float, looseness: flo
                  p=p, top_x=top_x, top_z=top_z, bottom=bottom)
 
 
+def shirt_torso(m: BodyMeasurements, body_vertices: np.ndarray, length: float,
+                looseness: float) -> tuple[float, Stack]:
+    """The hem height and torso solid of a top-half garment (T-shirt, top): ``length``
+    0 puts the hem at the natural waist (cropped), 1 at 12 cm below the crotch (tunic);
+    a hem below the hips hangs like a skirt (``body_vertices (N_b, 3)``)."""
+    z_hem = m.z_waist - length * (m.z_waist - (m.z_crotch - 0.12))
+    torso = trunk_stack(m, z_hem - 0.1, float(m.shoulder_z.max()) + 0.1, looseness,
+                        skirt_from=m.z_hip if z_hem < m.z_hip else None,
+                        vertices=body_vertices)
+    return z_hem, torso
+
+
 def _containing_scale(points: np.ndarray, z: np.ndarray, cx: np.ndarray, cy: np.ndarray,
                       a: np.ndarray, bf: np.ndarray, bb: np.ndarray, p: np.ndarray) -> np.ndarray:
     """``(K,)`` factor by which each section (at heights ``z``, 1 cm apart) must grow to
@@ -113,6 +132,10 @@ LEG_GAP = 0.03  # metres: least gap between the two trouser legs where they are 
 # Blend between the two legs: rounds the crease at the top of the inseam; it only
 # bridges gaps under half its size, well below LEG_GAP.
 LEG_BLEND = 0.02
+# Blend between the hips and the legs (trousers, jumpsuits): wide, so the seat runs
+# smoothly into the thighs; the legs are one hard union, so it never bridges the gap
+# between them.
+SEAT_BLEND = 0.07
 
 
 def leg_stacks(m: BodyMeasurements, looseness: float, flare: float, flare_from: float,
@@ -393,3 +416,21 @@ def upper_parts(body_vertices: np.ndarray, m: BodyMeasurements, torso: Stack, *,
                                    neck_depth=neck_depth, back_depth=back_depth,
                                    neck_width=neck_width, neckline=neckline), 3, "neck"
     return solids, [neck, *cuts], 3, "neck"
+
+
+#: :func:`upper_parts`' settings: a garment type's style fields of these names set them.
+UPPER_SETTINGS = ("sleeves", "sleeve_length", "sleeve_looseness", "sleeve_flare", "neckline",
+                  "neck_depth", "back_depth", "neck_width", "strap", "armhole_drop", "top_edge")
+
+
+def styled_upper_parts(body_vertices: np.ndarray, m: BodyMeasurements, torso: Stack,
+                       style: Style, **fixed: Any) -> tuple[list[Solid], list[Cut], int, str]:
+    """:func:`upper_parts` with each of :data:`UPPER_SETTINGS` read from the style field
+    of that name, except those given in ``fixed`` (what the garment type does not let
+    vary: a T-shirt is always sleeved and has no straps).
+
+    Raises:
+        AttributeError: if a setting is neither a field of ``style`` nor in ``fixed``.
+    """
+    settings = {name: getattr(style, name) for name in UPPER_SETTINGS if name not in fixed}
+    return upper_parts(body_vertices, m, torso, **settings, **fixed)

@@ -96,16 +96,11 @@ class UniformTable:
 
 
 @dataclasses.dataclass
-class Stack:
-    """A generalised cylinder along Z with superelliptic cross-sections.
-
-    At height ``z`` the section is centred at ``(cx, cy)``, reaches ``a`` to each side in
-    X, ``bf`` to the front (−Y) and ``bb`` to the back (+Y), with exponent ``p`` (2 =
-    ellipse, larger = boxier). Profiles are sampled at increasing ``z`` (all ``(K,)``,
-    metres) and held constant beyond the ends. Optional ``top`` caps the solid at the
-    height ``top_z`` over ``top_x`` (a shoulder line); optional ``bottom`` caps it from
-    below at one height (the crotch of a pair of trousers).
-    """
+class Sections:
+    """Superelliptic sections at heights ``z`` (all ``(K,)``, metres): centre ``(cx, cy)``,
+    half-width ``a``, front depth ``bf`` (−Y), back depth ``bb`` (+Y), exponent ``p``
+    (2 = ellipse, larger = boxier). A body's measured sections
+    (:mod:`.measurements`) and the profile of a :class:`Stack` solid."""
 
     z: np.ndarray
     cx: np.ndarray
@@ -114,6 +109,34 @@ class Stack:
     bf: np.ndarray
     bb: np.ndarray
     p: np.ndarray
+
+    def at(self, z: float) -> dict[str, float]:
+        """The section interpolated at one height."""
+        return {name: float(np.interp(z, self.z, getattr(self, name)))
+                for name in ("cx", "cy", "a", "bf", "bb", "p")}
+
+    def between(self, low: float, high: float) -> Sections:
+        """The sections with ``low <= z <= high`` (at least the two nearest)."""
+        keep = (self.z >= low) & (self.z <= high)
+        if keep.sum() < 2:
+            keep = np.argsort(np.abs(self.z - (low + high) / 2))[:2]
+            keep = np.sort(keep)
+        # Sections' own fields only: a Stack's caps are not per height.
+        return Sections(*(getattr(self, f.name)[keep] for f in dataclasses.fields(Sections)))
+
+
+@dataclasses.dataclass
+class Stack(Sections):
+    """A generalised cylinder along Z with superelliptic cross-sections.
+
+    At height ``z`` the section is centred at ``(cx, cy)``, reaches ``a`` to each side in
+    X, ``bf`` to the front (−Y) and ``bb`` to the back (+Y), with exponent ``p`` (2 =
+    ellipse, larger = boxier): the :class:`Sections` fields, sampled at increasing ``z``
+    (all ``(K,)``, metres) and held constant beyond the ends. Optional ``top`` caps the
+    solid at the height ``top_z`` over ``top_x`` (a shoulder line); optional ``bottom``
+    caps it from below at one height (the crotch of a pair of trousers).
+    """
+
     top_x: np.ndarray | None = None
     top_z: np.ndarray | None = None
     bottom: float | None = None

@@ -7,10 +7,9 @@ from typing import ClassVar
 
 from data_prep.garments.body_frame import BodyFrame
 from data_prep.garments.outline import GarmentOutline
-from data_prep.garments.parts import bounds, hem_cut, trunk_stack, upper_parts
+from data_prep.garments.parts import NECKLINES, bounds, hem_cut, shirt_torso, styled_upper_parts
 from data_prep.garments.shapes import Design
 from data_prep.garments.style import Style, choice, number
-from data_prep.garments.tshirt import NECKLINES, hem_height
 
 
 @dataclasses.dataclass(frozen=True)
@@ -34,16 +33,11 @@ class TopStyle(Style):
 
 def top_outline(body: BodyFrame, style: TopStyle) -> GarmentOutline:
     m = body.measurements
-    z_hem = hem_height(body, style.length)
-    torso = trunk_stack(m, z_hem - 0.1, float(m.shoulder_z.max()) + 0.1, style.looseness,
-                        skirt_from=m.z_hip if z_hem < m.z_hip else None,
-                        vertices=body.vertices)
+    z_hem, torso = shirt_torso(m, body.vertices, style.length, style.looseness)
     sleeves = "strapless" if style.kind == "strapless" else "sleeveless"
-    extra, cuts, loops, top = upper_parts(
-        body.vertices, m, torso, sleeves=sleeves, sleeve_length=0.0, sleeve_looseness=0.0,
-        sleeve_flare=0.0, neckline=style.neckline, neck_depth=style.neck_depth,
-        back_depth=style.back_depth, neck_width=style.neck_width, strap=style.strap,
-        armhole_drop=style.armhole_drop, top_edge=style.top_edge)
+    extra, cuts, loops, top = styled_upper_parts(
+        body.vertices, m, torso, style, sleeves=sleeves, sleeve_length=0.0,
+        sleeve_looseness=0.0, sleeve_flare=0.0)
     solids = [torso, *extra]
     design = Design(solids=solids, cuts=[hem_cut(z_hem, torso), *cuts],
                     bounds=bounds(solids, z_hem - 0.03, float(m.shoulder_z.max()) + 0.15))

@@ -8,10 +8,18 @@ from typing import ClassVar
 import numpy as np
 
 from data_prep.garments.body_frame import BodyFrame
+from data_prep.garments.errors import PatternError
 from data_prep.garments.measurements import BodyMeasurements
 from data_prep.garments.outline import GarmentOutline
-from data_prep.garments.parts import LEG_BLEND, bounds, hem_cut, leg_stacks, trunk_stack, waist_cut
-from data_prep.garments.pattern import PatternError
+from data_prep.garments.parts import (
+    LEG_BLEND,
+    SEAT_BLEND,
+    bounds,
+    hem_cut,
+    leg_stacks,
+    trunk_stack,
+    waist_cut,
+)
 from data_prep.garments.shapes import Design, Group, Stack
 from data_prep.garments.style import Style, number
 
@@ -32,10 +40,11 @@ class TrousersStyle(Style):
     crotch_drop: float = number(0.02, 0.0, 0.06, "crotch seam below the body's crotch (m)")
 
 
-def leg_parts(m: BodyMeasurements, hips: Stack, z_hem: float, leg_looseness: float,
+def leg_parts(m: BodyMeasurements, hips: Stack, length: float, leg_looseness: float,
               flare: float, flare_from: float) -> tuple[list[Stack], float]:
-    """Both legs' solids, reaching up into the ``hips`` solid, and the hem height (raised
-    to where the legs are apart, so each leg keeps its own opening).
+    """Both legs' solids, reaching up into the ``hips`` solid, and the hem height: at
+    ``length`` 0 4 cm below the crotch, at 1 3 cm above the ankle, but raised to where
+    the legs are apart, so each leg keeps its own opening.
 
     Near the crotch a leg's measured section includes part of the seat; there the leg
     is trimmed to stay inside the hips (the seat would otherwise bulge out), so the two
@@ -44,6 +53,8 @@ def leg_parts(m: BodyMeasurements, hips: Stack, z_hem: float, leg_looseness: flo
     Raises:
         PatternError: if the legs are never apart above the ankles.
     """
+    top_of_hem = m.z_crotch - 0.04
+    z_hem = top_of_hem - length * (top_of_hem - (m.z_ankle + 0.03))
     start = m.z_crotch - flare_from * (m.z_crotch - m.z_knee)
     raw, z_apart = leg_stacks(m, leg_looseness, flare, start, top=m.z_crotch + 0.06)
     z_hem = min(z_hem, z_apart - 0.03)
@@ -70,16 +81,13 @@ def leg_parts(m: BodyMeasurements, hips: Stack, z_hem: float, leg_looseness: flo
 def trousers_outline(body: BodyFrame, style: TrousersStyle) -> GarmentOutline:
     m = body.measurements
     z_waist = m.z_hip + style.waist_height * (m.z_waist - m.z_hip)
-    top_of_hem = m.z_crotch - 0.04
-    z_hem = top_of_hem - style.length * (top_of_hem - (m.z_ankle + 0.03))
     z_crotch = m.z_crotch - style.crotch_drop
     hips = trunk_stack(m, z_crotch - 0.05, z_waist + 0.1, style.looseness, cap=False,
                        bottom=z_crotch)
-    legs, z_hem = leg_parts(m, hips, z_hem, style.leg_looseness, style.flare, style.flare_from)
+    legs, z_hem = leg_parts(m, hips, style.length, style.leg_looseness, style.flare,
+                            style.flare_from)
     solids = [hips, Group(tuple(legs), blend=LEG_BLEND)]
-    # A wide blend: the seat runs smoothly into the thighs (the legs are one hard union,
-    # so the blend never bridges the gap between them).
-    design = Design(solids=solids, blend=0.07,
+    design = Design(solids=solids, blend=SEAT_BLEND,
                     cuts=[waist_cut(z_waist), hem_cut(z_hem, legs[0], name="leg")],
                     bounds=bounds(solids, z_hem, z_waist + 0.03))
     return GarmentOutline(design=design, loops=3, top="waist")

@@ -7,11 +7,16 @@ from typing import ClassVar
 
 from data_prep.garments.body_frame import BodyFrame
 from data_prep.garments.outline import GarmentOutline
-from data_prep.garments.parts import bounds, hem_cut, hem_low, trunk_stack, upper_parts
+from data_prep.garments.parts import (
+    NECKLINES,
+    bounds,
+    hem_cut,
+    hem_low,
+    shirt_torso,
+    styled_upper_parts,
+)
 from data_prep.garments.shapes import Design
 from data_prep.garments.style import Style, choice, number
-
-NECKLINES = ("round", "v", "boat", "square")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -33,24 +38,12 @@ class TShirtStyle(Style):
     front_rise: float = number(0.0, -0.03, 0.05, "hem higher in front than at the back (m)")
 
 
-def hem_height(body: BodyFrame, length: float) -> float:
-    """Hem height for a top-half garment: ``length`` 0 = natural waist, 1 = 12 cm below
-    the crotch."""
-    m = body.measurements
-    return m.z_waist - length * (m.z_waist - (m.z_crotch - 0.12))
-
-
 def tshirt_outline(body: BodyFrame, style: TShirtStyle) -> GarmentOutline:
     m = body.measurements
-    z_hem = hem_height(body, style.length)
-    torso = trunk_stack(m, z_hem - 0.1, float(m.shoulder_z.max()) + 0.1, style.looseness,
-                        skirt_from=m.z_hip if z_hem < m.z_hip else None,
-                        vertices=body.vertices)
-    extra, cuts, loops, top = upper_parts(
-        body.vertices, m, torso, sleeves="sleeved", sleeve_length=style.sleeve_length,
-        sleeve_looseness=style.sleeve_looseness, sleeve_flare=style.sleeve_flare,
-        neckline=style.neckline, neck_depth=style.neck_depth, back_depth=style.back_depth,
-        neck_width=style.neck_width, strap=0.0, armhole_drop=0.0, top_edge=0.0)
+    z_hem, torso = shirt_torso(m, body.vertices, style.length, style.looseness)
+    extra, cuts, loops, top = styled_upper_parts(
+        body.vertices, m, torso, style, sleeves="sleeved", strap=0.0, armhole_drop=0.0,
+        top_edge=0.0)
     solids = [torso, *extra]
     hem = hem_cut(z_hem, torso, front_rise=style.front_rise)
     design = Design(solids=solids, cuts=[hem, *cuts],
