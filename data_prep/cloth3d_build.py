@@ -155,7 +155,7 @@ def build_from_cloth3d(root: str | Path, smpl_model: str | Path | None, output: 
     from tqdm import tqdm
 
     from data_prep.cloth3d import Cloth3DError, read_info, read_sequence, scan_dataset
-    from gnngarment.body.motion_io import load_cloth3d_motion
+    from gnngarment.body.cloth3d_motion import load_cloth3d_motion
     from gnngarment.body.smpl_model import SMPL_DOWNLOAD_HINT, SMPLBodyModel
     from gnngarment.body.weight_transfer import transfer_body_weights
     from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs

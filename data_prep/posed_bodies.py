@@ -4,7 +4,7 @@
 The cache stores per frame only body *samples* (``body_points``); resolving garment
 penetrations needs the whole body mesh. A synthetic build is a pure function of its
 config (stored in the manifest), so each sequence's body is posed again here exactly as
-:func:`data_prep.build.simulate_sequence` posed it, and checked against the stored
+:func:`data_prep.sequence_worker.simulate_sequence` posed it, and checked against the stored
 samples: a cache built by another version of the planner, the motions or the body
 model gives no mesh (with a warning) rather than a wrong one.
 """
@@ -31,8 +31,8 @@ def synthetic_body_meshes(root: str | Path) -> Callable[[str], BodyMesh | None]:
 
     Anny is constructed on the first call (about a second with its cache in place).
     """
-    from data_prep.build import plan_dataset, planned_motion
     from data_prep.config import DataConfig
+    from data_prep.plan import plan_dataset, planned_motion
     from gnngarment.config import ConfigError, merge_config
     from gnngarment.data.cache import read_manifest, read_sequence
 

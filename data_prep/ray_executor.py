@@ -1,8 +1,8 @@
 """Run a build's worker tasks as Ray tasks (``prepare --executor ray``).
 
 One Ray task per call (one per sequence, one per (design, body) drape). Ray reuses its
-worker processes across tasks, so the per-process cache of :mod:`data_prep.build` (the
-Anny body model, Warp's loaded kernels) is built once per worker process, not per task.
+worker processes across tasks, so what a worker process keeps (the Anny body model of
+:mod:`data_prep.bodies`, Warp's loaded kernels) is built once per worker process, not per task.
 A worker process that dies mid-task (SIGKILL, OOM killer, a lost node) is retried by Ray
 (``max_retries``); the worker functions write every file to a temporary name and rename
 it, so a killed attempt leaves no half-written file, only a hidden temporary that the

@@ -30,6 +30,7 @@ import numpy as np
 
 from data_prep.cloth3d.errors import Cloth3DError
 from gnngarment.io.atomic import atomic_write
+from gnngarment.io.mat import MatFileError, read_mat
 
 #: Fields every CLOTH3D ``info.mat`` has and :func:`read_info` / :func:`write_info` need.
 REQUIRED_FIELDS = ("poses", "trans", "shape", "gender", "zrot", "outfit")
@@ -56,19 +57,13 @@ def read_info(path: str | Path) -> dict[str, Any]:
         Cloth3DError: missing or unreadable file, a required field missing, or a field
             of the wrong shape (e.g. poses and trans with different frame counts).
     """
-    from scipy.io import loadmat
-
     path = Path(path)
     if not path.is_file():
         raise Cloth3DError(f"{path}: info.mat not found")
     try:
-        raw = loadmat(path, struct_as_record=False, squeeze_me=True)
-    except NotImplementedError as error:  # scipy's message for v7.3 (HDF5) files
-        raise Cloth3DError(f"{path}: cannot read MAT file ({error})") from error
-    except Exception as error:  # scipy raises many kinds for a broken file
-        raise Cloth3DError(f"{path}: cannot read MAT file "
-                           f"({type(error).__name__}: {error})") from error
-    info = {key: _to_python(value) for key, value in raw.items() if not key.startswith("__")}
+        info = read_mat(path)
+    except MatFileError as error:
+        raise Cloth3DError(str(error)) from None
     try:
         return normalise_info(info, stored=True)
     except ValueError as error:
@@ -145,25 +140,6 @@ def _real(value: Any, name: str) -> float:
             or not np.isfinite(array.astype(np.float64)).all():
         raise ValueError(f"{name} is {value!r}, expected one finite number")
     return float(array.item())
-
-
-def _to_python(value: Any) -> Any:
-    """loadmat output → dicts, lists, Python scalars, str and numeric arrays."""
-    from scipy.io.matlab import mat_struct
-
-    if isinstance(value, mat_struct):
-        return {name: _to_python(getattr(value, name)) for name in value._fieldnames}
-    if isinstance(value, np.ndarray):
-        if value.dtype == object:  # cell array or struct array
-            return [_to_python(item) for item in value.ravel()]
-        if value.dtype.kind == "U" and value.size == 0:  # how '' comes back
-            return ""
-        if value.ndim == 0:
-            return value.item()
-        return value
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
 
 
 def write_info(path: str | Path, info: Mapping[str, Any]) -> Path:

@@ -260,8 +260,9 @@ def prepare(
         raise fail(f"--workers must be >= 0 (0: one per core), got {workers}")
     from dataclasses import replace
 
-    from data_prep.build import build_dataset, plan_dataset
+    from data_prep.build import build_dataset
     from data_prep.config import DataConfig
+    from data_prep.plan import plan_dataset
     from data_prep.ray_executor import RayMissingError
     from data_prep.simulate import load_simulation_settings
 

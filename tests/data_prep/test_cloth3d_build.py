@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from data_prep.cloth3d import write_info, write_obj, write_sequence, z_rotation
 from data_prep.cloth3d_build import build_from_cloth3d, smpl_model_files
-from gnngarment.body.motion_io import load_cloth3d_motion
+from gnngarment.body.cloth3d_motion import load_cloth3d_motion
 from gnngarment.body.smpl_model import SMPLBodyModel
 from gnngarment.cli import app
 from gnngarment.data import PreparedDataset

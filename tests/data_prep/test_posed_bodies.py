@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 import torch
 
-from data_prep.build import plan_dataset
 from data_prep.config import DataConfig
+from data_prep.plan import plan_dataset
 from data_prep.posed_bodies import synthetic_body_meshes
 from gnngarment.body.anny_model import AnnyShape
 from gnngarment.body.procedural import make_motion

@@ -20,8 +20,10 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from data_prep.build import _intact_npz, _lost, build_dataset, plan_dataset
+from data_prep.build import build_dataset
+from data_prep.build_records import _intact_npz, lost_task
 from data_prep.config import DataConfig
+from data_prep.plan import plan_dataset
 from gnngarment.cli import app
 from gnngarment.config import ConfigError, merge_config
 from gnngarment.io.atomic import TEMP_SUFFIX
@@ -134,7 +136,7 @@ def test_an_executor_that_started_ray_stops_it() -> None:
     import subprocess
 
     code = ("import ray\n"
-            "from data_prep.build import _hash\n"
+            "from data_prep.inputs_hash import _hash\n"
             "from data_prep.ray_executor import RayExecutor\n"
             "with RayExecutor() as executor:\n"
             "    assert executor._owned and ray.is_initialized()\n"
@@ -155,8 +157,8 @@ def test_a_lost_task_is_named_and_not_recorded_as_failed(tmp_path: Path) -> None
     but leaves no ``.failed`` record: the next build tries it again."""
     plan = plan_dataset(tiny_config(tmp_path))[0]
     error = RuntimeError("worker died")
-    sequence = _lost((str(tmp_path), plan, None, "hash"), error)
-    garment = _lost((str(tmp_path), plan.design, plan.body, None, "hash"), error)
+    sequence = lost_task((str(tmp_path), plan, None, "hash"), error)
+    garment = lost_task((str(tmp_path), plan.design, plan.body, None, "hash"), error)
     assert (sequence["name"], garment["name"]) == (plan.name, plan.garment)
     assert not sequence["ok"] and "worker lost" in sequence["reason"]
     assert not list(tmp_path.rglob("*.failed"))

@@ -1,0 +1,55 @@
+"""The inputs hash of every sequence and drape a build makes: what its content depends
+on, hashed. A built file is recorded with it (its ``.hash`` file, or in its ``.failed``
+record), so a resumed build skips what it would only make again and redoes what changed.
+
+The payloads are a file format: existing caches are resumed by these hashes, so a change
+to what is hashed rebuilds every cache (that is what :data:`BUILDER_VERSION` is for).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import asdict
+from typing import Any
+
+from data_prep.config import DataConfig
+from data_prep.plan import BodyPlan, DesignPlan, SequencePlan
+
+#: Bumped when the builder's output changes for the same config (forces a rebuild).
+BUILDER_VERSION = 1
+
+#: Config keys that only decide *which* garments, bodies and motions are planned: their
+#: effect on a sequence is all in its plan (hashed with it), so changing them (e.g. more
+#: motions per pair) keeps every sequence and drape already built.
+PLAN_KEYS = ("seed", "garment_types", "garments", "garment_vertices", "bodies",
+             "body_presets", "motions", "motions_per_pair", "motion_variants", "fabrics",
+             "splits")
+#: Config keys that decide nothing a worker computes.
+PLACE_KEYS = ("output", "workers", "simulation", "executor", "ray_address")
+
+
+def content_inputs(config: DataConfig, settings: Any) -> dict[str, Any]:
+    """What every sequence's and drape's content depends on besides its own plan: not
+    where the dataset lives, how many processes build it or where, the path of the
+    simulation file (its ``settings`` are hashed), nor what only chooses the plans."""
+    content = {k: v for k, v in asdict(config).items() if k not in PLACE_KEYS + PLAN_KEYS}
+    return {"builder": BUILDER_VERSION, "config": content, "simulation": asdict(settings)}
+
+
+def sequence_inputs_hash(inputs: dict[str, Any], plan: SequencePlan) -> str:
+    """The hash a built sequence is recorded with (its ``.hash`` file). A canonical
+    motion (tempo and amplitude 1) is hashed without those two fields."""
+    fields = asdict(plan)
+    fields["motion"] = {key: value for key, value in fields["motion"].items()
+                        if key not in ("speed", "amplitude") or value != 1.0}
+    return _hash({**inputs, "plan": fields})
+
+
+def garment_inputs_hash(inputs: dict[str, Any], design: DesignPlan, body: BodyPlan) -> str:
+    """The hash a draped garment (``design`` fitted to ``body``) is recorded with."""
+    return _hash({**inputs, "design": asdict(design), "body": asdict(body)})
+
+
+def _hash(payload: Any) -> str:
+    return hashlib.sha256(json.dumps(payload, sort_keys=True, default=str).encode()).hexdigest()

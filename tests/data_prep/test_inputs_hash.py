@@ -1,0 +1,39 @@
+"""Inputs hashes: growing a config keeps the hash of every sequence it already planned;
+what changes a simulation changes every hash."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from data_prep.inputs_hash import content_inputs, sequence_inputs_hash
+from data_prep.plan import plan_dataset
+from tests.data_prep.test_build import tiny_config
+
+
+def test_more_motions_per_pair_keeps_every_built_sequence(tmp_path: Path) -> None:
+    """Growing a dataset (more motions per pair, motion variants) plans every sequence it
+    had with the same inputs hash, so a resumed build simulates only the new ones; each
+    new variant moves at a tempo and amplitude of its own."""
+    from data_prep.simulate import load_simulation_settings
+
+    config = tiny_config(tmp_path)
+    grown = replace(config, motions_per_pair=config.motions_per_pair + 1, motion_variants=2)
+    settings = load_simulation_settings(config.simulation)
+    before = {p.name: sequence_inputs_hash(content_inputs(config, settings), p)
+              for p in plan_dataset(config)}
+    after = {p.name: p for p in plan_dataset(grown)}
+    hashes = {name: sequence_inputs_hash(content_inputs(grown, settings), p)
+              for name, p in after.items()}
+    assert all(hashes[name] == value for name, value in before.items())
+    variants = [p.motion for p in after.values() if p.motion.speed != 1.0]
+    assert len(variants) == len(after) - len(before) > 1
+    assert len({(m.speed, m.amplitude, m.seed) for m in variants}) == len(variants)
+    with pytest.raises(ValueError, match="motions_per_pair"):  # a motion twice per pair
+        plan_dataset(replace(config, motions_per_pair=config.motions_per_pair + 1))
+    # a change that alters what is simulated changes every hash
+    slower = replace(config, fps=config.fps / 2)
+    assert not any(sequence_inputs_hash(content_inputs(slower, settings), p) == before[p.name]
+                   for p in plan_dataset(slower))
