@@ -28,6 +28,8 @@ from gnngarment.body.anny_model import (
     sample_anny_shapes,
 )
 from gnngarment.body.body_model import BodyModel, PosedBody, RestBody
+from gnngarment.body.bvh_motion import load_bvh_motion
+from gnngarment.body.cloth3d_motion import load_cloth3d_motion, read_cloth3d_info
 from gnngarment.body.config import BodyConfig, load_body_config
 from gnngarment.body.factory import create_body_model
 from gnngarment.body.features import (
@@ -39,14 +41,7 @@ from gnngarment.body.features import (
     vertex_velocities,
 )
 from gnngarment.body.motion import Motion, MotionError
-from gnngarment.body.motion_io import (
-    load_amass_motion,
-    load_bvh_motion,
-    load_cloth3d_motion,
-    load_motion,
-    motion_from_smpl,
-    read_cloth3d_info,
-)
+from gnngarment.body.motion_io import load_motion
 from gnngarment.body.procedural import MOTION_LIBRARY, list_motions, make_motion
 from gnngarment.body.sampling import farthest_point_sampling
 from gnngarment.body.skeleton import (
@@ -57,6 +52,7 @@ from gnngarment.body.skeleton import (
 )
 from gnngarment.body.skinning import skin
 from gnngarment.body.smpl_model import SMPLBodyModel, SMPLModelError
+from gnngarment.body.smpl_motion import load_amass_motion, motion_from_smpl
 
 __all__ = [
     "ANNY_JOINT_BONES",

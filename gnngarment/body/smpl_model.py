@@ -19,9 +19,9 @@ import torch
 
 from gnngarment.body.body_model import BodyModel, PosedBody, RestBody
 from gnngarment.body.motion import Motion
-from gnngarment.body.motion_io import SMPL_TO_CANONICAL
 from gnngarment.body.rotations import axis_angle_to_matrix
 from gnngarment.body.skeleton import NUM_JOINTS, forward_kinematics
+from gnngarment.body.smpl_motion import SMPL_TO_CANONICAL
 
 NUM_BETAS = 10
 SMPL_DOWNLOAD_HINT = (

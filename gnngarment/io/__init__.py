@@ -8,6 +8,7 @@ gnngarment.io.<module>`` loads only numpy and that module):
 - :mod:`~gnngarment.io.npz`: :func:`~gnngarment.io.npz.save_npz_atomic`,
   :func:`~gnngarment.io.npz.load_npz` (errors name the file)
 - :mod:`~gnngarment.io.point_cache`: PointCache2 ``.pc2`` (float32) / ``.pc16`` (float16)
+- :mod:`~gnngarment.io.mat`: MATLAB v5 ``.mat`` (CLOTH3D's ``info.mat``) as plain Python
 - :mod:`~gnngarment.io.obj`: Wavefront OBJ text (:func:`~gnngarment.io.obj.write_obj`,
   :func:`~gnngarment.io.obj.obj_text`); reading OBJ is
   :func:`gnngarment.geometry.load_mesh`'s job

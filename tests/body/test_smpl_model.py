@@ -7,10 +7,10 @@ import pytest
 import torch
 
 from gnngarment.body.motion import Motion
-from gnngarment.body.motion_io import SMPL_TO_CANONICAL
 from gnngarment.body.skeleton import JOINT_INDEX
 from gnngarment.body.skinning import skin
 from gnngarment.body.smpl_model import SMPLBodyModel, SMPLModelError
+from gnngarment.body.smpl_motion import SMPL_TO_CANONICAL
 from tests.smpl_files import synthetic_smpl as _synthetic_smpl
 
 
