@@ -31,10 +31,13 @@ from gnngarment.paths import REPOSITORY_ROOT, SHIPPED_MODEL
 console = Console()
 
 
-def unseen_garment(out: Path, seed: int = 20261123) -> tuple[Path, Any, Any]:
+def unseen_garment(out: Path, seed: int = 20261123,
+                   resolution: tuple[int, int] = (1200, 1600),
+                   drape_frames: int = 90) -> tuple[Path, Any, Any]:
     """A garment design that is in no dataset (its own seed), on a body shape that is in
-    no split (the "tall" phenotype below), written as OBJ. Returns the path, the body
-    model and the shape."""
+    no split (the "tall" phenotype below), draped for at most ``drape_frames`` and
+    written as OBJ; ``resolution`` is its (lowest, highest) vertex count. Returns the
+    path, the body model and the shape."""
     import trimesh
 
     from data_prep.garments import BodyFrame, sample_garment
@@ -47,11 +50,11 @@ def unseen_garment(out: Path, seed: int = 20261123) -> tuple[Path, Any, Any]:
     rest = body_model.rest(shape)
     frame = BodyFrame(vertices=rest.vertices.numpy(), faces=rest.faces,
                       joints=rest.joints.numpy())
-    garment = sample_garment(frame, seed, garment_type="dress", resolution=(1200, 1600))
+    garment = sample_garment(frame, seed, garment_type="dress", resolution=resolution)
     # The model animates a garment as worn at rest (DESIGN.md): settle the design on the
     # rest body first, as the dataset builder does, with the reference simulator.
     draped = drape_garment(garment.pos, garment.faces, rest.vertices.numpy(), body_model.faces,
-                           max_frames=90)
+                           max_frames=drape_frames)
     console.print(f"unseen dress draped on the rest body in {draped.frames} frames "
                   f"({draped.seconds:.0f} s; it settled {1000 * draped.mean_displacement:.0f} "
                   "mm from its design on average)")
@@ -62,9 +65,11 @@ def unseen_garment(out: Path, seed: int = 20261123) -> tuple[Path, Any, Any]:
 
 def run(out: Path, data_config: Path, train_config: Path, model_path: Path | None,
         attribution_steps: int = 50, motion_seconds: float = 2.0,
-        workspace: Path | None = None) -> dict[str, Any]:
+        workspace: Path | None = None, unseen_resolution: tuple[int, int] = (1200, 1600),
+        unseen_drape_frames: int = 90) -> dict[str, Any]:
     """The five stages; ``workspace`` (if given) replaces the configs' dataset and run
-    folders (``<workspace>/data``, ``<workspace>/run``)."""
+    folders (``<workspace>/data``, ``<workspace>/run``); ``unseen_resolution`` and
+    ``unseen_drape_frames`` size the unseen dress of stage 4 (smaller in the tests)."""
     from data_prep.build import build_dataset
     from data_prep.config import DataConfig
     from data_prep.posed_bodies import synthetic_body_meshes, synthetic_skinning_weights
@@ -132,7 +137,8 @@ def run(out: Path, data_config: Path, train_config: Path, model_path: Path | Non
     console.rule("4/5 animate an unseen garment")
     animator = models.get("shipped", models["demo run"])
     summary["animated_with"] = "shipped" if "shipped" in models else "demo run"
-    garment_path, body_model, shape = unseen_garment(out)
+    garment_path, body_model, shape = unseen_garment(out, resolution=unseen_resolution,
+                                                      drape_frames=unseen_drape_frames)
     pos, faces = load_mesh(garment_path)
     body = body_shape_inputs(body_model, shape, animator.config.body_vertices)
     frames = body_motion_inputs(body_model, shape,

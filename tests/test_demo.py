@@ -22,7 +22,8 @@ def test_quick_demo_end_to_end(tmp_path: Path, anny_body) -> None:
     configs = REPOSITORY_ROOT / "configs"
     summary = run(tmp_path / "out", configs / "data" / "tiny.yaml",
                   configs / "train" / "tiny.yaml", None, attribution_steps=4,
-                  motion_seconds=0.3, workspace=tmp_path / "work")
+                  motion_seconds=0.3, workspace=tmp_path / "work",
+                  unseen_resolution=(400, 600), unseen_drape_frames=30)
     assert summary["dataset"]["splits"]["train"] >= 1
     assert summary["training"]["epochs"] == 3
     assert [s["to"] for s in summary["training"]["switches"]][:2] == ["physics",

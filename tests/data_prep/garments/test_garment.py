@@ -4,8 +4,6 @@ body and where clothes sit; resolution, styles, seeds, the sampler; on the synth
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 
@@ -175,14 +173,6 @@ def test_sampler_is_seeded_and_respects_the_type(body: BodyFrame) -> None:
     assert np.array_equal(a.pos, b.pos)
     with pytest.raises(ValueError, match="unknown garment type"):
         sample_garment(body, 0, "cape")
-
-
-def test_generation_is_fast(body: BodyFrame) -> None:
-    make_garment(body, "tshirt", target_vertices=3000, seed=0)  # warm-up (imports)
-    start = time.process_time()
-    make_garment(body, "jumpsuit", {"sleeves": "sleeved"}, target_vertices=3000, seed=0)
-    # ~0.5 s of CPU on an idle 2-core machine, validation included; generous bound.
-    assert time.process_time() - start < 3.0
 
 
 def test_a_pose_body(body: BodyFrame) -> None:

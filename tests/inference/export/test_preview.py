@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -81,13 +80,11 @@ def test_bad_extension(tmp_path: Path) -> None:
 
 
 @pytest.mark.slow
-def test_sixty_frames_of_a_2k_garment_on_a_13k_body_in_under_10_seconds(tmp_path) -> None:
+def test_sixty_frames_of_a_2k_garment_on_a_13k_body_make_a_small_gif(tmp_path) -> None:
+    """(Its CPU time is measured by benchmarks/generation_and_preview_speed.py.)"""
     animation = synthetic_animation(frames=60, rings=40, sections=50, body_rings=130,
                                     body_sections=104)
     assert animation.body_vertices.shape[1] > 13000
-    # CPU time: shared test machines stretch wall time several-fold (measured here:
-    # ~2.5 s CPU, 3–6 s wall on a loaded 2-core machine).
-    started = time.process_time()
     path = render_preview(animation, tmp_path / "p.gif", max_frames=60)
-    assert time.process_time() - started < 10.0
+    assert len(iio.imread(path, index=None)) == 60
     assert path.stat().st_size < 3e6
