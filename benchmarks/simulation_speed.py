@@ -23,6 +23,7 @@ import numpy as np
 
 from data_prep.garments import flared_skirt
 from data_prep.simulate import SimulationSettings, simulate_garment
+from gnngarment.geometry.normals import face_normals
 
 #: Stride period of the procedural walk [s] and the time its amplitude eases in over [s].
 STRIDE_PERIOD = 1.1
@@ -134,8 +135,7 @@ def sharp_fold_fraction(pos: np.ndarray, faces: np.ndarray, degrees: float = 30.
     order = np.lexsort((key[:, 1], key[:, 0]))
     key, face_of = key[order], face_of[order]
     shared = (key[1:] == key[:-1]).all(axis=1)
-    normal = np.cross(pos[faces[:, 1]] - pos[faces[:, 0]], pos[faces[:, 2]] - pos[faces[:, 0]])
-    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    normal = face_normals(pos, faces)
     cosine = np.einsum("ij,ij->i", normal[face_of[:-1][shared]], normal[face_of[1:][shared]])
     return float(np.mean(cosine < np.cos(np.radians(degrees))))
 
@@ -166,8 +166,7 @@ def _shaded_polygons(vertices: np.ndarray, faces: np.ndarray, view: np.ndarray,
     right = np.cross(view, [0.0, 0.0, 1.0])
     right /= np.linalg.norm(right)
     tri = vertices[faces]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    normal /= np.linalg.norm(normal, axis=1, keepdims=True) + 1e-12
+    normal = face_normals(vertices, faces)
     light = np.abs(normal @ -view)  # two-sided: the skirt's inside shows through the hem
     shade = (0.35 + 0.65 * light)[:, None] * colour[None]
     projected = np.stack([tri @ right, tri[..., 2]], axis=-1)

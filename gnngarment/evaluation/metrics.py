@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from gnngarment.geometry.normals import face_normals
+
 
 def vertex_error(pred: np.ndarray, target: np.ndarray) -> np.ndarray:
     """E_verts: mean per-vertex Euclidean distance (metres) per frame."""
@@ -17,8 +19,7 @@ def vertex_error(pred: np.ndarray, target: np.ndarray) -> np.ndarray:
 
 
 def _vertex_normals(pos: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    corners = pos[:, faces]  # (T, F, 3, 3)
-    face_normal = np.cross(corners[:, :, 1] - corners[:, :, 0], corners[:, :, 2] - corners[:, :, 0])
+    face_normal = face_normals(pos, faces, normalize=False)  # (T, F, 3), area-weighted
     normals = np.zeros_like(pos)
     for k in range(3):
         np.add.at(normals, (slice(None), faces[:, k]), face_normal)

@@ -6,12 +6,18 @@ import numpy as np
 
 
 def face_normals(pos: np.ndarray, faces: np.ndarray, normalize: bool = True) -> np.ndarray:
-    """``(F, 3)`` face normals (right-handed winding); unnormalised ones have length
-    twice the triangle area."""
-    corners = np.asarray(pos)[np.asarray(faces)]
-    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    """Face normals (right-handed winding); unnormalised ones have length twice the
+    triangle area.
+
+    Shapes:
+        pos: ``(..., N, 3)`` (leading axes, e.g. frames, are kept), faces: ``(F, 3)`` →
+        ``(..., F, 3)``.
+    """
+    corners = np.asarray(pos)[..., np.asarray(faces), :]  # (..., F, 3 corners, 3)
+    normals = np.cross(corners[..., 1, :] - corners[..., 0, :],
+                       corners[..., 2, :] - corners[..., 0, :])
     if normalize:
-        normals = normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
+        normals = normals / np.maximum(np.linalg.norm(normals, axis=-1, keepdims=True), 1e-300)
     return normals
 
 
