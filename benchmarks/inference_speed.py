@@ -89,15 +89,10 @@ def make_pair(pos: np.ndarray, faces: np.ndarray, config: ModelConfig,
     joints = rng.normal(scale=0.3, size=(24, 3))
     prepared = prepare_garment(pos, faces, GarmentPreparationConfig(
         levels=config.levels, landmarks=config.landmarks))
-    return GarmentBodyPair(
-        rest_pos=torch.tensor(pos, dtype=torch.float32),
-        features=torch.from_numpy(garment_vertex_features(pos, faces, joints)),
-        hierarchy=prepared.hierarchy,
-        descriptor=torch.tensor(prepared.descriptor, dtype=torch.float32),
-        body_distances=torch.tensor(rng.random((config.body_vertices, 24)),
-                                    dtype=torch.float32),
-        body_weights=torch.tensor(rng.dirichlet(np.ones(24), size=len(pos)),
-                                  dtype=torch.float32))
+    return GarmentBodyPair.from_arrays(
+        pos, garment_vertex_features(pos, faces, joints), prepared.hierarchy,
+        prepared.descriptor, rng.random((config.body_vertices, 24)),
+        rng.dirichlet(np.ones(24), size=len(pos)))
 
 
 def frame_inputs(config: ModelConfig, frames: int, seed: int = 0

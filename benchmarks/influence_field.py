@@ -173,13 +173,9 @@ def make_pair(pos: np.ndarray, faces: np.ndarray, body: Body, config: ModelConfi
 
     prepared = prepare_garment(pos, faces, GarmentPreparationConfig(
         levels=hierarchy_levels, landmarks=config.landmarks))
-    return GarmentBodyPair(
-        rest_pos=torch.tensor(pos, dtype=torch.float32),
-        features=torch.from_numpy(garment_vertex_features(pos, faces, body.joints)),
-        hierarchy=prepared.hierarchy,
-        descriptor=torch.tensor(prepared.descriptor, dtype=torch.float32),
-        body_distances=torch.from_numpy(np.asarray(body.distances, dtype=np.float32)),
-        body_weights=torch.from_numpy(body.garment_weights(pos)))
+    return GarmentBodyPair.from_arrays(
+        pos, garment_vertex_features(pos, faces, body.joints), prepared.hierarchy,
+        prepared.descriptor, body.distances, body.garment_weights(pos))
 
 
 def build_models(arguments: argparse.Namespace) -> dict[str, GarmentDeformer]:

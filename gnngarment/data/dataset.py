@@ -151,7 +151,6 @@ class PreparedDataset:
                              f"{hierarchy.num_vertices} vertices, garment {garment} has "
                              f"{len(record.rest_pos)}")
         features = garment_vertex_features(record.rest_pos, record.faces, body_record.joints)
-        rest = torch.from_numpy(record.rest_pos.astype(np.float32))
         faces = torch.from_numpy(record.faces.astype(np.int64))
         edge_index = hierarchy.edge_index
         edges = torch.from_numpy(edge_index[:, edge_index[0] < edge_index[1]].astype(np.int64))
@@ -159,16 +158,14 @@ class PreparedDataset:
         # Both cache builders store the transferred body weights; a cache without them
         # cannot recompute them (it keeps no body mesh): the pair then has none, and a
         # model with the ``body`` weight prior rejects it by name.
-        body_weights = (None if record.body_weights is None
-                        else torch.from_numpy(record.body_weights.astype(np.float32)))
-        if body_weights is not None and tuple(body_weights.shape) != (len(rest), NUM_JOINTS):
+        body_weights = record.body_weights
+        count = len(record.rest_pos)
+        if body_weights is not None and tuple(body_weights.shape) != (count, NUM_JOINTS):
             raise CacheError(f"{self.root}/garments/{garment}.npz: body_weights has shape "
-                             f"{tuple(body_weights.shape)}, expected ({len(rest)}, {NUM_JOINTS})")
-        pair = GarmentBodyPair(
-            rest_pos=rest, features=torch.from_numpy(features), hierarchy=hierarchy,
-            descriptor=torch.from_numpy(record.descriptor.astype(np.float32)),
-            body_distances=torch.from_numpy(body_record.distances.astype(np.float32)),
-            body_weights=body_weights)
+                             f"{tuple(body_weights.shape)}, expected ({count}, {NUM_JOINTS})")
+        pair = GarmentBodyPair.from_arrays(record.rest_pos, features, hierarchy,
+                                           record.descriptor, body_record.distances,
+                                           body_weights)
         mass = vertex_masses(record.rest_pos, record.faces, self.fabric_density)
         return _GarmentData(pair=pair, faces=faces, edges=edges,
                             rest_inverse=torch.from_numpy(rest_inverse.astype(np.float32)),

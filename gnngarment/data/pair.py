@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
 import torch
 
 from gnngarment.geometry.hierarchy import PoolHierarchy
@@ -30,3 +31,17 @@ class GarmentBodyPair:
     descriptor: torch.Tensor
     body_distances: torch.Tensor
     body_weights: torch.Tensor | None = None
+
+    @classmethod
+    def from_arrays(cls, rest_pos: np.ndarray, features: np.ndarray, hierarchy: PoolHierarchy,
+                    descriptor: np.ndarray, body_distances: np.ndarray,
+                    body_weights: np.ndarray | None = None) -> GarmentBodyPair:
+        """The pair from numpy arrays (any float dtype; each becomes a float32 tensor),
+        with the shapes of the attributes above: the one place the data layer, ``animate``
+        and the benchmarks turn arrays into the model's input."""
+        def tensor(values: np.ndarray) -> torch.Tensor:
+            return torch.from_numpy(np.asarray(values, dtype=np.float32))
+
+        return cls(rest_pos=tensor(rest_pos), features=tensor(features), hierarchy=hierarchy,
+                   descriptor=tensor(descriptor), body_distances=tensor(body_distances),
+                   body_weights=None if body_weights is None else tensor(body_weights))

@@ -91,17 +91,14 @@ def garment_pair(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,
             raise ValueError(f"{source}: the model's weight_prior 'body' needs the body's "
                              "skinning weights (BodyShapeInputs.skinning_weights is None; "
                              "the body model does not expose them)")
-        body_weights = torch.from_numpy(transfer_body_weights(
-            np.asarray(pos, dtype=np.float64), body.rest_vertices, body.skinning_weights))
+        body_weights = transfer_body_weights(
+            np.asarray(pos, dtype=np.float64), body.rest_vertices, body.skinning_weights)
     if prepared is None:
         prepared = prepare_garment(pos, faces, GarmentPreparationConfig(
             levels=config.levels, landmarks=config.landmarks), source=source)
-    features = garment_vertex_features(pos, faces, body.joints)
-    return GarmentBodyPair(
-        rest_pos=torch.tensor(pos, dtype=torch.float32),
-        features=torch.from_numpy(features), hierarchy=prepared.hierarchy,
-        descriptor=torch.tensor(prepared.descriptor, dtype=torch.float32),
-        body_distances=torch.from_numpy(body.distances), body_weights=body_weights)
+    return GarmentBodyPair.from_arrays(
+        pos, garment_vertex_features(pos, faces, body.joints), prepared.hierarchy,
+        prepared.descriptor, body.distances, body_weights)
 
 
 #: Garment vertices × frames per forward pass (16 frames of a 5,000-vertex garment).

@@ -52,6 +52,22 @@ def test_body_weights_default_to_unknown() -> None:
         check_pair_fits(bare, config())
 
 
+def test_from_arrays_gives_float32_tensors_of_the_same_values() -> None:
+    pair = make_pair(*tube(4, 6), config())
+    built = GarmentBodyPair.from_arrays(
+        pair.rest_pos.double().numpy(), pair.features.numpy(), pair.hierarchy,
+        pair.descriptor.double().numpy(), pair.body_distances.numpy(),
+        pair.body_weights.double().numpy())
+    for name in ("rest_pos", "features", "descriptor", "body_distances", "body_weights"):
+        value = getattr(built, name)
+        assert value.dtype == torch.float32, name
+        assert torch.equal(value, getattr(pair, name)), name
+    assert built.hierarchy is pair.hierarchy
+    assert GarmentBodyPair.from_arrays(
+        pair.rest_pos.numpy(), pair.features.numpy(), pair.hierarchy,
+        pair.descriptor.numpy(), pair.body_distances.numpy()).body_weights is None
+
+
 def test_cached_pairs_have_the_documented_shapes_and_contents(cache: Path) -> None:
     dataset = PreparedDataset(cache, "train", window=2)
     for name in dataset.sequence_names:
