@@ -30,10 +30,14 @@ from gnngarment.paths import REPOSITORY_ROOT, SHIPPED_MODEL
 
 console = Console()
 
+#: The unseen dress of stage 4: its (lowest, highest) vertex count and drape frame cap.
+UNSEEN_RESOLUTION = (1200, 1600)
+UNSEEN_DRAPE_FRAMES = 90
+
 
 def unseen_garment(out: Path, seed: int = 20261123,
-                   resolution: tuple[int, int] = (1200, 1600),
-                   drape_frames: int = 90) -> tuple[Path, Any, Any]:
+                   resolution: tuple[int, int] = UNSEEN_RESOLUTION,
+                   drape_frames: int = UNSEEN_DRAPE_FRAMES) -> tuple[Path, Any, Any]:
     """A garment design that is in no dataset (its own seed), on a body shape that is in
     no split (the "tall" phenotype below), draped for at most ``drape_frames`` and
     written as OBJ; ``resolution`` is its (lowest, highest) vertex count. Returns the
@@ -65,8 +69,9 @@ def unseen_garment(out: Path, seed: int = 20261123,
 
 def run(out: Path, data_config: Path, train_config: Path, model_path: Path | None,
         attribution_steps: int = 50, motion_seconds: float = 2.0,
-        workspace: Path | None = None, unseen_resolution: tuple[int, int] = (1200, 1600),
-        unseen_drape_frames: int = 90) -> dict[str, Any]:
+        workspace: Path | None = None,
+        unseen_resolution: tuple[int, int] = UNSEEN_RESOLUTION,
+        unseen_drape_frames: int = UNSEEN_DRAPE_FRAMES) -> dict[str, Any]:
     """The five stages; ``workspace`` (if given) replaces the configs' dataset and run
     folders (``<workspace>/data``, ``<workspace>/run``); ``unseen_resolution`` and
     ``unseen_drape_frames`` size the unseen dress of stage 4 (smaller in the tests)."""
