@@ -23,29 +23,13 @@ import numpy as np
 
 from data_prep.garments import flared_skirt
 from data_prep.simulate import SimulationSettings, simulate_garment
+from gnngarment.geometry.graph import largest_component
 from gnngarment.geometry.normals import face_normals
+from gnngarment.mesh_drawing import DrawnMesh, draw_meshes
 
 #: Stride period of the procedural walk [s] and the time its amplitude eases in over [s].
 STRIDE_PERIOD = 1.1
 EASE_IN = 0.5
-
-
-def _largest_component(faces: np.ndarray, num_vertices: int) -> tuple[np.ndarray, np.ndarray]:
-    """Vertex indices of the largest connected component and its re-indexed faces (Anny
-    also has a tongue and two eyes, which would make the collider non-manifold)."""
-    import scipy.sparse
-    from scipy.sparse.csgraph import connected_components
-
-    rows = faces.ravel()
-    cols = faces[:, [1, 2, 0]].ravel()
-    graph = scipy.sparse.coo_matrix((np.ones(len(rows)), (rows, cols)),
-                                    shape=(num_vertices, num_vertices))
-    _, labels = connected_components(graph, directed=False)
-    largest = np.argmax(np.bincount(labels))
-    keep = np.flatnonzero(labels == largest)
-    remap = np.full(num_vertices, -1)
-    remap[keep] = np.arange(len(keep))
-    return keep, remap[faces[(labels[faces] == largest).all(axis=1)]]
 
 
 def _rot_x(angle: np.ndarray) -> np.ndarray:
@@ -87,7 +71,7 @@ def anny_walk(num_frames: int, fps: float) -> tuple[np.ndarray, np.ndarray]:
     with torch.no_grad():
         out = model(pose_parameters=torch.tensor(pose, dtype=torch.float32))
     vertices = out["vertices"].double().numpy()
-    keep, faces = _largest_component(model.faces.numpy().astype(np.int64),
+    keep, faces = largest_component(model.faces.numpy().astype(np.int64),
                                      vertices.shape[1])
     return vertices[:, keep], faces
 
@@ -159,48 +143,22 @@ def time_inside_tests(body: np.ndarray, faces: np.ndarray, points: np.ndarray) -
           f"({warp_inside.sum()} vs {reference_inside.sum()} inside)")
 
 
-def _shaded_polygons(vertices: np.ndarray, faces: np.ndarray, view: np.ndarray,
-                     colour: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Projected triangles ``(F, 3, 2)``, their depth ``(F,)`` and Lambert-shaded RGB
-    ``(F, 3)`` for an orthographic camera looking along ``view`` (Z stays up)."""
-    right = np.cross(view, [0.0, 0.0, 1.0])
-    right /= np.linalg.norm(right)
-    tri = vertices[faces]
-    normal = face_normals(vertices, faces)
-    light = np.abs(normal @ -view)  # two-sided: the skirt's inside shows through the hem
-    shade = (0.35 + 0.65 * light)[:, None] * colour[None]
-    projected = np.stack([tri @ right, tri[..., 2]], axis=-1)
-    return projected, tri.mean(axis=1) @ view, shade
-
-
 def draw(body: np.ndarray, faces: np.ndarray, garment: np.ndarray,
          garment_faces: np.ndarray, frames: list[int], path: Path) -> None:
-    """Front and side views of ``frames`` (painter's algorithm, body grey, garment blue),
-    PNG at ``path``."""
+    """Front and side views of ``frames`` (body grey, garment blue), PNG at ``path``."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.collections import PolyCollection
 
-    views = (np.array([0.0, 1.0, 0.0]), np.array([-1.0, 0.0, 0.0]))  # front (−Y), side
+    views = (0.0, -90.0)  # azimuths: front (camera on −Y), side (camera on +X)
     fig, axes = plt.subplots(2, len(frames), figsize=(1.5 * len(frames), 4.4))
     for column, frame in enumerate(frames):
-        for row, view in enumerate(views):
-            parts = [_shaded_polygons(body[frame], faces, view, np.array([0.75, 0.72, 0.7])),
-                     _shaded_polygons(garment[frame], garment_faces, view,
-                                      np.array([0.25, 0.45, 0.85]))]
-            polygons = np.concatenate([p[0] for p in parts])
-            depth = np.concatenate([p[1] for p in parts])
-            colours = np.concatenate([p[2] for p in parts])
-            order = np.argsort(-depth)  # far first
+        for row, azimuth in enumerate(views):
             ax = axes[row, column]
-            ax.add_collection(PolyCollection(polygons[order], facecolors=colours[order],
-                                             edgecolors="none", antialiased=False))
-            ax.set_xlim(-0.55, 0.55)
-            ax.set_ylim(-0.9, 0.8)
-            ax.set_aspect("equal")
-            ax.axis("off")
+            draw_meshes(ax, [DrawnMesh(body[frame], faces, (0.75, 0.72, 0.7)),
+                             DrawnMesh(garment[frame], garment_faces, (0.25, 0.45, 0.85))],
+                        azimuth, 0.0, limits=((-0.55, 0.55), (-0.9, 0.8)), antialiased=False)
             if row == 0:
                 ax.set_title(f"frame {frame}", fontsize=8)
     fig.tight_layout(pad=0.2)

@@ -18,7 +18,7 @@ import numpy as np
 
 from data_prep.garments.body_frame import BodyFrame
 from data_prep.garments.garment import GARMENT_TYPES, Garment, sample_garment
-from data_prep.garments.render import draw_meshes
+from gnngarment.mesh_drawing import DrawnMesh, draw_meshes
 
 #: Anny phenotypes the sheet cycles through (gender 0 = male, 1 = female).
 PHENOTYPES: tuple[dict[str, float], ...] = (
@@ -90,10 +90,10 @@ def render(garments: list[tuple[Garment, BodyFrame]], path: Path, columns: int =
         ax.set_axis_off()
     for ax, (garment, body) in zip(np.ravel(axes), garments, strict=False):
         # Crop the body to the garment's height range (plus a margin) so it stays large.
-        draw_meshes(ax, [(garment.pos, garment.faces, GARMENT_RGB, 1.0),
-                         (body.vertices, body.faces, BODY_RGB, 1.0)],
-                    azimuth_deg=25.0, elevation_deg=8.0, edge_color=(0.05, 0.1, 0.2),
-                    edge_width=0.05, flat=(1,))
+        draw_meshes(ax, [DrawnMesh(garment.pos, garment.faces, GARMENT_RGB),
+                         DrawnMesh(body.vertices, body.faces, BODY_RGB, lit=False)],
+                    azimuth_deg=25.0, elevation_deg=-8.0, edge_color=(0.05, 0.1, 0.2),
+                    edge_width=0.05)
         ax.set_title(caption(garment), fontsize=6.5, pad=2)
     figure.subplots_adjust(left=0.01, right=0.99, top=0.96, bottom=0.01, wspace=0.02,
                            hspace=0.18)
@@ -135,12 +135,12 @@ def pipeline_figure(body: BodyFrame, path: Path, seed: int = 4) -> None:
     for ax in axes[:2]:
         ax.set_aspect("equal")
         ax.set_axis_off()
-    draw_meshes(axes[2], [(lifted, panels.faces, GARMENT_RGB, 1.0)], 60.0, 10.0,
+    draw_meshes(axes[2], [DrawnMesh(lifted, panels.faces, GARMENT_RGB)], 60.0, -10.0,
                 edge_color="k", edge_width=0.15)
     axes[2].set_title("lifted along Y (sparse at the folds)", fontsize=8)
-    draw_meshes(axes[3], [(final.pos, final.faces, GARMENT_RGB, 1.0),
-                          (body.vertices, body.faces, BODY_RGB, 1.0)], 60.0, 10.0,
-                edge_color="k", edge_width=0.15, flat=(1,))
+    draw_meshes(axes[3], [DrawnMesh(final.pos, final.faces, GARMENT_RGB),
+                          DrawnMesh(body.vertices, body.faces, BODY_RGB, lit=False)],
+                60.0, -10.0, edge_color="k", edge_width=0.15)
     axes[3].set_title("relaxed on the surface, flipped, pushed out", fontsize=8)
     figure.tight_layout()
     _save_small(figure, path, dpi=90)

@@ -14,13 +14,18 @@ from gnngarment.attribution.colors import (
     heat_colors,
     normalise_heat,
 )
-from gnngarment.geometry.normals import face_normals
 from gnngarment.io.atomic import atomic_write_bytes
+from gnngarment.mesh_drawing import DrawnMesh, draw_meshes, project
 
-#: ``(elevation, azimuth)`` in degrees of the default views of a Z-up garment: front
-#: (camera on −Y, the body's front) and back.
-DEFAULT_VIEWS: tuple[tuple[float, float], ...] = ((12.0, -90.0), (12.0, 90.0))
-VIEW_NAMES = {(12.0, -90.0): "front", (12.0, 90.0): "back"}
+#: ``(elevation, azimuth)`` in degrees of the default views of a Z-up garment
+#: (:mod:`gnngarment.mesh_drawing`'s convention): front (camera on −Y, the body's
+#: front) and back.
+DEFAULT_VIEWS: tuple[tuple[float, float], ...] = ((12.0, 0.0), (12.0, 180.0))
+VIEW_NAMES = {(12.0, 0.0): "front", (12.0, 180.0): "back"}
+
+#: Brightness of a heatmap face turned away from the light: high, so that shading shows
+#: the folds without changing the colour map's reading much.
+HEAT_AMBIENT = 0.55
 
 
 def render_attribution(path: str | Path, pos: np.ndarray, faces: np.ndarray, heat: np.ndarray,
@@ -78,12 +83,11 @@ def render_comparison(path: str | Path, pos: np.ndarray, faces: np.ndarray,
     single = len(heats) == 1
     rows, cols = (1, len(views)) if single else (len(views), len(heats))
     figure = Figure(figsize=(3.2 * cols + 1.2, 3.6 * rows + 0.4 + (0.5 if suptitle else 0.0)))
-    shade = _face_shading(pos, faces)
     for k, value in enumerate(values):
         for v, (elevation, azimuth) in enumerate(views):
             index = v if single else v * cols + k
-            axes = figure.add_subplot(rows, cols, index + 1, projection="3d")
-            _draw(axes, pos, faces, value, shade, colormap, elevation, azimuth, marked)
+            axes = figure.add_subplot(rows, cols, index + 1)
+            _draw(axes, pos, faces, value, colormap, elevation, azimuth, marked)
             view = VIEW_NAMES.get((elevation, azimuth), f"elev {elevation:g}, azim {azimuth:g}")
             heading = f"{titles[k]}\n{view}" if titles[k] and (single or v == 0) else view
             axes.set_title(heading, fontsize=9)
@@ -103,56 +107,34 @@ def render_comparison(path: str | Path, pos: np.ndarray, faces: np.ndarray,
     return atomic_write_bytes(path, buffer.getvalue())
 
 
-def _face_shading(pos: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """``(F,)`` brightness in ``[0.55, 1]``: two-sided Lambert light from the camera's
-    side, so folds stay readable under the colour map."""
-    normals = face_normals(pos, faces)
-    light = np.array([0.3, -0.8, 0.5]) / np.linalg.norm([0.3, -0.8, 0.5])
-    return 0.55 + 0.45 * np.abs(normals @ light)
-
-
-def _draw(axes, pos: np.ndarray, faces: np.ndarray, value: np.ndarray, shade: np.ndarray,
-          colormap: str, elevation: float, azimuth: float, marked: np.ndarray | None) -> None:
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
-    colors = heat_colors(value[faces].mean(axis=1), colormap).astype(np.float64) / 255.0
-    colors[:, :3] *= shade[:, None]
-    # Edges in the face colour hide the hairline seams antialiasing leaves between faces.
-    axes.add_collection3d(Poly3DCollection(pos[faces], facecolors=colors, edgecolors=colors,
-                                           linewidths=0.3))
+def _draw(axes, pos: np.ndarray, faces: np.ndarray, value: np.ndarray, colormap: str,
+          elevation: float, azimuth: float, marked: np.ndarray | None) -> None:
+    colors = heat_colors(value[faces].mean(axis=1), colormap)[:, :3].astype(np.float64) / 255.0
+    draw_meshes(axes, [DrawnMesh(pos, faces, colors, ambient=HEAT_AMBIENT)], azimuth,
+                elevation)
     if marked is not None and marked.size:
-        # Drawn last and outside the depth sort so the mark always shows. A ring, so the
-        # heat under it stays visible; faint and thin where the vertex is behind cloth,
-        # so the two views do not both seem to face the target.
-        axes.computed_zorder = False
-        visible = _visible(pos, marked, elevation, azimuth)
+        # Drawn over the mesh so the mark always shows. A ring, so the heat under it
+        # stays visible; faint and thin where the vertex is behind cloth, so the two
+        # views do not both seem to face the target.
+        camera = project(pos, azimuth, elevation)
+        visible = _visible(camera, marked)
         size = 90 if marked.size == 1 else 14
         for show, width, alpha in ((visible, 2.0, 1.0), (~visible, 1.0, 0.5)):
             if show.any():
-                axes.scatter(*pos[marked[show]].T, s=size, facecolors="none",
-                             edgecolors="#00e5ff", linewidths=width, alpha=alpha,
-                             depthshade=False, zorder=10)
-    centre = (pos.max(axis=0) + pos.min(axis=0)) / 2
-    half = (pos.max(axis=0) - pos.min(axis=0)).max() / 2 or 1.0
-    axes.set_xlim(centre[0] - half, centre[0] + half)
-    axes.set_ylim(centre[1] - half, centre[1] + half)
-    axes.set_zlim(centre[2] - half, centre[2] + half)
-    axes.set_box_aspect((1, 1, 1), zoom=1.1)
-    axes.view_init(elev=elevation, azim=azimuth)
-    axes.set_axis_off()
+                axes.scatter(*camera[marked[show], :2].T, s=size, facecolors="none",
+                             edgecolors="#00e5ff", linewidths=width, alpha=alpha, zorder=10)
 
 
-def _visible(pos: np.ndarray, marked: np.ndarray, elevation: float, azimuth: float) -> np.ndarray:
+def _visible(camera: np.ndarray, marked: np.ndarray) -> np.ndarray:
     """``(K,)`` whether each marked vertex is in front: no vertex that projects near it
     on the screen (within 3% of the garment's size) is more than 2% closer to the
-    camera. Orientation-free, so it works for open garments with either winding."""
-    e, a = np.radians(elevation), np.radians(azimuth)
-    towards_camera = np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
-    right = np.array([-np.sin(a), np.cos(a), 0.0])
-    up = np.cross(towards_camera, right)
-    size = float(np.ptp(pos, axis=0).max()) or 1.0
-    depth = pos @ towards_camera
-    screen = np.column_stack([pos @ right, pos @ up])
+    camera. Orientation-free, so it works for open garments with either winding.
+
+    Shapes:
+        camera ``(N, 3)`` (screen X, screen Y, depth towards the viewer), marked ``(K,)``.
+    """
+    size = float(np.ptp(camera, axis=0).max()) or 1.0
+    depth, screen = camera[:, 2], camera[:, :2]
     visible = np.empty(len(marked), dtype=bool)
     for k, vertex in enumerate(marked):
         near = np.linalg.norm(screen - screen[vertex], axis=1) < 0.03 * size
