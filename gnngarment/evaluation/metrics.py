@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gnngarment.geometry.normals import face_normals
+from gnngarment.geometry.normals import vertex_normals
 
 
 def vertex_error(pred: np.ndarray, target: np.ndarray) -> np.ndarray:
@@ -18,18 +18,10 @@ def vertex_error(pred: np.ndarray, target: np.ndarray) -> np.ndarray:
     return np.linalg.norm(pred - target, axis=-1).mean(-1)
 
 
-def _vertex_normals(pos: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    face_normal = face_normals(pos, faces, normalize=False)  # (T, F, 3), area-weighted
-    normals = np.zeros_like(pos)
-    for k in range(3):
-        np.add.at(normals, (slice(None), faces[:, k]), face_normal)
-    return normals / np.maximum(np.linalg.norm(normals, axis=-1, keepdims=True), 1e-12)
-
-
 def normal_error(pred: np.ndarray, target: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """E_norm: mean angle (degrees) between predicted and true area-weighted vertex
     normals, per frame."""
-    cosine = (_vertex_normals(pred, faces) * _vertex_normals(target, faces)).sum(-1)
+    cosine = (vertex_normals(pred, faces) * vertex_normals(target, faces)).sum(-1)
     return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0))).mean(-1)
 
 

@@ -28,13 +28,15 @@ def vertex_normals(pos: np.ndarray, faces: np.ndarray) -> np.ndarray:
     and the result does not depend on how finely a flat region is triangulated.
 
     Shapes:
-        pos: ``(N, 3)``, faces: ``(F, 3)`` → ``(N, 3)`` unit normals; vertices used by no
-        face (or whose faces cancel) get the zero vector.
+        pos: ``(..., N, 3)`` (any leading axes, e.g. frames), faces: ``(F, 3)`` →
+        ``(..., N, 3)`` float64 unit normals; vertices used by no face (or whose faces
+        cancel) get the zero vector.
     """
     pos = np.asarray(pos, dtype=np.float64)
+    faces = np.asarray(faces)
     weighted = face_normals(pos, faces, normalize=False)
     normals = np.zeros_like(pos)
     for corner in range(3):
-        np.add.at(normals, np.asarray(faces)[:, corner], weighted)
-    length = np.linalg.norm(normals, axis=1, keepdims=True)
+        np.add.at(normals, (Ellipsis, faces[:, corner], slice(None)), weighted)
+    length = np.linalg.norm(normals, axis=-1, keepdims=True)
     return np.where(length > 0, normals / np.where(length > 0, length, 1.0), 0.0)

@@ -37,6 +37,22 @@ def test_sphere_normals_point_outward_and_flat_grid_points_up() -> None:
     np.testing.assert_allclose(vertex_normals(pos, faces), [[0, 0, 1]] * len(pos), atol=1e-12)
 
 
+def test_vertex_normals_of_frames_are_each_frames_normals() -> None:
+    """Leading axes (frames, as E_norm passes them) give each frame's own normals, and a
+    vertex no face uses gets the zero vector."""
+    sphere = trimesh.creation.icosphere(subdivisions=2)
+    faces = np.asarray(sphere.faces)
+    rng = np.random.default_rng(0)
+    frames = sphere.vertices[None] * rng.uniform(0.5, 2.0, (3, 1, 3))  # stretched spheres
+    frames = np.concatenate([frames, np.zeros((3, 1, 3))], axis=1)     # one unused vertex
+    together = vertex_normals(frames.astype(np.float32), faces)
+    assert together.shape == frames.shape and together.dtype == np.float64
+    for t in range(3):
+        np.testing.assert_array_equal(together[t], vertex_normals(frames[t].astype(np.float32),
+                                                                   faces))
+    np.testing.assert_array_equal(together[:, -1], 0.0)
+
+
 def test_scale_is_unit_and_resolution_independent() -> None:
     pos, faces = grid(5, 5, spacing=0.25)  # a 1 m × 1 m sheet
     assert np.isclose(surface_area(pos, faces), 1.0)
