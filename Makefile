@@ -34,9 +34,14 @@ $(NODE_STAMP): package.json package-lock.json
 	npm ci --silent --no-audit --no-fund
 	touch $(NODE_STAMP)
 
+# The suite runs in TEST_WORKERS processes (pytest-xdist), whole test files to a worker so
+# that module fixtures are built once; one torch thread each, since two workers already
+# fill the two cores and a second thread per worker only waits for a descheduled one.
+TEST_WORKERS ?= 2
+
 test: $(STAMP) $(NODE_STAMP)
 	$(VENV)/bin/ruff check .
-	$(PY) -m pytest
+	OMP_NUM_THREADS=1 $(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
