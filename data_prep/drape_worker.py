@@ -18,8 +18,10 @@ from data_prep.garment_fitting import make_garment, write_pins
 from data_prep.left_the_body import left_the_body
 from data_prep.plan import BodyPlan, DesignPlan
 from gnngarment.io.atomic import atomic_write_bytes
+from gnngarment.threads import one_thread
 
 
+@one_thread()
 def drape_and_prepare_garment(task: tuple[str, DesignPlan, BodyPlan, DataConfig, str]
                               ) -> dict[str, Any]:
     """Worker: fit a design to a body, drape it on the still rest body (the template,
@@ -32,8 +34,6 @@ def drape_and_prepare_garment(task: tuple[str, DesignPlan, BodyPlan, DataConfig,
     name = f"{design.name}_{body.name}"
     started = time.perf_counter()
     try:
-        import torch
-
         from data_prep.simulate import SimulationFailed, drape_garment, load_simulation_settings
         from gnngarment.body.weight_transfer import transfer_body_weights
         from gnngarment.data.cache import (
@@ -44,7 +44,6 @@ def drape_and_prepare_garment(task: tuple[str, DesignPlan, BodyPlan, DataConfig,
         )
         from gnngarment.geometry.prepare import GarmentPreparationConfig, prepare_garment
 
-        torch.set_num_threads(1)
         body_model = anny_body_model()
         rest = body_model.rest(anny_shape(body))
         body_vertices = rest.vertices.numpy()

@@ -18,8 +18,10 @@ from data_prep.garment_fitting import read_pins
 from data_prep.left_the_body import left_the_body
 from data_prep.plan import SequencePlan, planned_motion
 from gnngarment.io.atomic import atomic_write_bytes
+from gnngarment.threads import one_thread
 
 
+@one_thread()
 def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[str, Any]:
     """Worker: pose, simulate, check and write one sequence. Returns a status dict
     (never raises for a failed simulation: that sequence is reported and left out)."""
@@ -35,7 +37,6 @@ def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[s
         from gnngarment.data.cache import SequenceRecord, read_garment, write_sequence
         from gnngarment.geometry.normals import vertex_normals
 
-        torch.set_num_threads(1)
         body_model = anny_body_model()
         shape = anny_shape(plan.body)
         motion = planned_motion(plan.motion, config)

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 #: How long the idle cores are sampled (s).
@@ -73,3 +75,25 @@ def use_idle_cores() -> int:
     threads = choose_threads()
     torch.set_num_threads(threads)
     return threads
+
+
+@contextmanager
+def one_thread() -> Iterator[None]:
+    """Torch and the BLAS/OpenMP libraries (numpy's, scipy's, torch's) on one thread
+    inside the block, each restored after; also a decorator.
+
+    For work whose results must not depend on the machine's cores: LAPACK's eigenvalues
+    of the same matrix differ in the last bits between one and two threads (the Nyström
+    descriptors of a dataset build, ≤ 1.7e-15), which changed a cache's manifest hash
+    from one machine to another; and for workers that already run one per core.
+    """
+    import torch
+    from threadpoolctl import threadpool_limits
+
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        with threadpool_limits(limits=1):
+            yield
+    finally:
+        torch.set_num_threads(threads)

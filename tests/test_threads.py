@@ -33,3 +33,23 @@ def test_omp_num_threads_wins(monkeypatch) -> None:
     monkeypatch.setenv("OMP_NUM_THREADS", "3")
     monkeypatch.setattr(threads, "idle_cores", lambda sample_seconds: 0.1)
     assert threads.choose_threads() == 3
+
+
+def test_one_thread_limits_torch_and_blas_and_restores() -> None:
+    """Inside the block every BLAS/OpenMP library and torch run one thread (so a build's
+    LAPACK results do not depend on the machine's cores); after it, what was set before."""
+    import numpy  # noqa: F401  (loads OpenBLAS, so that there is a BLAS to limit)
+    import torch
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    torch_before = torch.get_num_threads()
+    with threadpool_limits(limits=2):
+        torch.set_num_threads(2)
+        try:
+            with threads.one_thread():
+                assert torch.get_num_threads() == 1
+                assert {pool["num_threads"] for pool in threadpool_info()} == {1}
+            assert torch.get_num_threads() == 2
+            assert {pool["num_threads"] for pool in threadpool_info()} == {2}
+        finally:
+            torch.set_num_threads(torch_before)

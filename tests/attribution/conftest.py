@@ -4,7 +4,6 @@ attributions most tests look at computed once per session."""
 from __future__ import annotations
 
 from collections.abc import Iterator
-from contextlib import contextmanager
 
 import numpy as np
 import pytest
@@ -13,6 +12,7 @@ import torch
 from gnngarment.attribution import Attribution, attribute
 from gnngarment.data.pair import GarmentBodyPair
 from gnngarment.model import GarmentDeformer, ModelConfig
+from gnngarment.threads import one_thread
 from tests.meshes import tube
 from tests.model.pairs import frame_inputs, make_pair, tiny_config
 
@@ -32,20 +32,10 @@ def build(levels: int, seed: int = 0) -> GarmentDeformer:
     return GarmentDeformer(attribution_config(levels)).eval()
 
 
-@contextmanager
-def one_thread() -> Iterator[None]:
-    """Graphs of ~150 vertices are too small to gain from intra-op threads, and on a
-    shared CPU the threads thrash (measured 3-8× slower); restore the setting after."""
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(threads)
-
-
 @pytest.fixture(autouse=True)
 def _one_thread() -> Iterator[None]:
+    """Graphs of ~150 vertices are too small to gain from intra-op threads, and on a
+    shared CPU the threads thrash (measured 3-8× slower)."""
     with one_thread():
         yield
 
