@@ -3,11 +3,11 @@
 The one mesh renderer of the static pictures (attribution heatmaps, the garment
 generator's contact sheets, the simulation benchmark's figure). A hand-rolled
 orthographic projection and painter's algorithm over one ``PolyCollection`` instead of
-``mplot3d``: it is faster, and it sorts every mesh of a picture in one depth order, so a
-garment correctly hides the body behind it (``mplot3d`` sorts each collection on its
-own). The animated GIF preview has its own numpy rasteriser
-(``inference/export/preview.py``): it draws 60 frames of a 13k-vertex body, where
-matplotlib would take minutes.
+``mplot3d``: it sorts every mesh of a picture in one depth order, so a garment correctly
+hides the body behind it (``mplot3d`` sorts each collection on its own). It is not
+faster: a two-view heatmap of a 5,000-vertex skirt takes 0.24 s, 0.18 s with
+``mplot3d`` (AMD EPYC, one thread). The animated GIF preview has its own numpy
+rasteriser (``inference/export/preview.py``), written for 60 frames of a 13k-vertex body.
 
 Conventions: world Z is up and the body faces −Y. A view is ``(azimuth, elevation)`` in
 degrees; azimuth 0 looks at the body's front (the camera on −Y), 90 from −X, −90 from
