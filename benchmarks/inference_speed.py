@@ -8,8 +8,11 @@ implementations (``csr``: GraphAttention, ``pyg``: GATConv), with:
 
 * the peak resident memory of the measuring process (each config × implementation runs
   in its own child process, so its peak is its own);
-* the csr runs with glibc's default malloc and with ``MALLOC_TUNED`` (large freed blocks
-  kept for reuse instead of unmapped: fresh multi-MB tensors otherwise pay page faults);
+* the csr runs with glibc's default malloc and with freed blocks kept for reuse
+  (``kept``: :func:`gnngarment.allocator.keep_freed_memory`, what every ``gnngarment``
+  command sets; ``tuned``: the same through ``MALLOC_TUNED`` environment variables):
+  fresh multi-MB tensors otherwise pay page faults;
+* with ``--compete``: all of it while a competing process keeps one core busy;
 * where the time goes (LSTMs, processors, skinning, the rest) and the top operators;
 * bf16 autocast (whole forward, and processors only): speed, the error of the posed
   vertices against float32 (max / mean, mm) and M^mp's relative error on unit-normal
@@ -29,7 +32,8 @@ implementations (``csr``: GraphAttention, ``pyg``: GATConv), with:
   model ÷ simulator ratio.
 
     .venv/bin/python benchmarks/inference_speed.py [--vertices 5000] [--configs small paper]
-        [--batches 1 16] [--attention csr pyg] [--malloc both] [--repeats 5]
+        [--batches 1 16] [--attention csr pyg] [--malloc default kept tuned] [--repeats 5]
+        [--compete]
         [--threads 1 2 auto]
         [--no-bf16] [--no-simulator] [--sim-frames 30]
         [--compile on] [--compile-target model processors layers]
@@ -64,6 +68,8 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from data_prep.garments.skirt import flared_skirt  # noqa: E402
+from gnngarment.allocator import SWITCH as KEEP_FREED_MEMORY  # noqa: E402
+from gnngarment.allocator import keep_freed_memory  # noqa: E402
 from gnngarment.config import load_config  # noqa: E402
 from gnngarment.data.pair import GarmentBodyPair  # noqa: E402
 from gnngarment.data.vertex_features import garment_vertex_features  # noqa: E402
@@ -430,9 +436,19 @@ def initial_model(config: ModelConfig, args: argparse.Namespace
     return GarmentDeformer(config).eval(), "random init"
 
 
+def start_competitor() -> subprocess.Popen:
+    """Another process busy on one core for as long as it runs: a one-thread float32
+    GEMM loop, like a second benchmark or a training run beside this one."""
+    code = ("import torch; torch.set_num_threads(1); a = torch.randn(512, 512)\n"
+            "while True: a = torch.tanh(a @ a)")
+    return subprocess.Popen([sys.executable, "-c", code], env=dict(os.environ,
+                                                                     OMP_NUM_THREADS="1"))
+
+
 def child(args: argparse.Namespace) -> None:
     """Measure one config at one thread count, every implementation in ``--impl``
     interleaved; print one JSON line per implementation."""
+    keep_freed_memory()  # applied only in the "kept" children (KEEP_FREED_MEMORY=1)
     if args.threads[0] == "auto":  # what the CLI does: the cores idle right now
         from gnngarment.threads import use_idle_cores
 
@@ -707,8 +723,15 @@ def main() -> None:
     parser.add_argument("--no-bf16", dest="bf16", action="store_false")
     parser.add_argument("--no-simulator", dest="simulator", action="store_false")
     parser.add_argument("--sim-frames", type=int, default=30)
-    parser.add_argument("--malloc", choices=["default", "tuned", "both"], default="both",
-                        help="glibc malloc settings of the csr runs (pyg: default)")
+    parser.add_argument("--malloc", nargs="+", choices=["default", "kept", "tuned"],
+                        default=["default", "kept"],
+                        help="glibc malloc settings of the csr runs (pyg: the first): "
+                             "default: glibc's; kept: gnngarment.allocator."
+                             "keep_freed_memory(), what every gnngarment command sets; "
+                             "tuned: the MALLOC_*_THRESHOLD_ environment variables")
+    parser.add_argument("--compete", action="store_true",
+                        help="run a competing process (a one-thread float32 GEMM loop) "
+                             "on the machine during every measurement")
     parser.add_argument("--profile-batch", type=int, default=16,
                         help="print the top operators of the csr runs at this batch")
     parser.add_argument("--compile", choices=["off", "on"], default="off",
@@ -739,7 +762,8 @@ def main() -> None:
           f"best of {args.repeats}; load average {os.getloadavg()[0]:.1f} on "
           f"{os.cpu_count()} cores")
     results = []
-    variants = ["default", "tuned"] if args.malloc == "both" else [args.malloc]
+    variants = list(dict.fromkeys(args.malloc))
+    competitor = start_competitor() if args.compete else None
     # Compiled variants: one child each (with its own eager csr reference, interleaved),
     # since dynamo's caches live on the code objects that all variants share: in one
     # process a second variant would reuse the first one's graphs and its first call
@@ -777,6 +801,7 @@ def main() -> None:
         if not args.bf16 or malloc != variants[0] or not main_child:
             command.append("--no-bf16")
         env = dict(os.environ, **(MALLOC_TUNED if malloc == "tuned" else {}))
+        env[KEEP_FREED_MEMORY] = "1" if malloc == "kept" else "0"
         if threads == "auto":  # the choice is the child's, not a variable's
             env.pop("OMP_NUM_THREADS", None)
         cache = None
@@ -805,6 +830,10 @@ def main() -> None:
               f"{f', {extra_name}' if extra_name else ''}, in {time.perf_counter() - tic:.0f} s",
               flush=True)
     best = report(results)
+    if competitor is not None:
+        competitor.kill()
+        competitor.wait()
+        print("(a competing one-thread GEMM process ran during every measurement above)")
 
     print()
     simulator_fps = None

@@ -26,6 +26,7 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
+from gnngarment.allocator import keep_freed_memory
 from gnngarment.paths import REPOSITORY_ROOT, SHIPPED_MODEL
 
 console = Console()
@@ -201,6 +202,7 @@ def main() -> None:
     parser.add_argument("--model", type=Path, default=None,
                         help="checkpoint to animate with (default: the shipped one)")
     arguments = parser.parse_args()
+    keep_freed_memory()  # as every gnngarment command (gnngarment/allocator.py)
     configs = REPOSITORY_ROOT / "configs"
     started = time.perf_counter()
     if arguments.quick:

@@ -15,6 +15,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from gnngarment.allocator import keep_freed_memory
 from gnngarment.cli.errors import (
     check_motion_options,
     check_output_file,
@@ -31,6 +32,8 @@ console = Console()
 @app.callback()
 def root() -> None:
     """Animate any garment mesh with one learned model."""
+    # Every command: freed tensors are reused instead of unmapped (gnngarment/allocator.py).
+    keep_freed_memory()
 
 
 def _garment_config(config_path: Path | None, levels: int | None):

@@ -8,6 +8,7 @@ every layer, frame and call on that graph reuses them.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import torch
@@ -49,16 +50,50 @@ class AttentionGraph:
     ``add_self_loops=True``), so every node attends at least to itself and no softmax
     segment is empty. Repeated edges are kept, as PyG keeps them.
 
+    A graph made of identical copies of smaller graphs (the frames of a garment,
+    :meth:`repeated`) remembers them as ``blocks``, so that the edge softmax can gather
+    with one copy's indices (:meth:`block_layouts`).
+
     Shapes:
         ptr ``(N + 1,)`` int64: incoming edges of node ``i`` are ``ptr[i]:ptr[i+1]``.
         source ``(E',)`` int64: source node of every edge, edges sorted by target.
     """
 
-    def __init__(self, ptr: torch.Tensor, source: torch.Tensor, num_nodes: int):
+    def __init__(self, ptr: torch.Tensor, source: torch.Tensor, num_nodes: int,
+                 blocks: tuple[tuple[AttentionGraph, int], ...] | None = None):
         self.ptr = ptr
         self.source = source
         self.num_nodes = num_nodes
+        #: ``((graph, copies), ...)``: this graph is, in node order, ``copies`` disjoint
+        #: copies of each ``graph`` in turn; ``None`` when not known to repeat.
+        self.blocks = blocks
         self._layouts: dict[int, HeadLayout] = {}
+
+    @classmethod
+    def repeated(cls, blocks: Sequence[tuple[AttentionGraph, int]]) -> AttentionGraph:
+        """The disjoint union of ``copies`` copies of each graph, in order (nodes and
+        edges numbered copy by copy): the same graph :meth:`from_edge_index` builds from
+        the offset, concatenated edge lists, knowing its ``blocks``."""
+        ptrs = [torch.zeros(1, dtype=torch.long)]
+        sources = []
+        nodes = edges = 0
+        for graph, copies in blocks:
+            copy = torch.arange(copies)[:, None]
+            ptrs.append((graph.ptr[None, 1:].cpu() + edges + copy * graph.num_edges).flatten())
+            sources.append((graph.source[None].cpu() + nodes + copy * graph.num_nodes).flatten())
+            nodes += copies * graph.num_nodes
+            edges += copies * graph.num_edges
+        device = blocks[0][0].device if blocks else torch.device("cpu")
+        with structure_mode():
+            source = torch.cat(sources) if sources else torch.zeros(0, dtype=torch.long)
+            return cls(torch.cat(ptrs).to(device), source.to(device), nodes,
+                       tuple((graph, copies) for graph, copies in blocks))
+
+    def block_layouts(self, heads: int) -> list[tuple[HeadLayout, int]] | None:
+        """``[(layout of one copy, copies), ...]`` for :attr:`blocks`, or ``None``."""
+        if self.blocks is None:
+            return None
+        return [(graph.layout(heads), copies) for graph, copies in self.blocks]
 
     @classmethod
     def from_edge_index(cls, edge_index: torch.Tensor, num_nodes: int) -> AttentionGraph:
@@ -114,7 +149,10 @@ class AttentionGraph:
         """This graph on ``device`` (``self`` when already there)."""
         if torch.device(device) == self.device:
             return self
-        return AttentionGraph(self.ptr.to(device), self.source.to(device), self.num_nodes)
+        blocks = (None if self.blocks is None else
+                  tuple((graph.to(device), copies) for graph, copies in self.blocks))
+        return AttentionGraph(self.ptr.to(device), self.source.to(device), self.num_nodes,
+                              blocks)
 
     def layout(self, heads: int) -> HeadLayout:
         """Index structures for ``heads`` attention heads (built on first use, cached)."""

@@ -48,6 +48,13 @@ class DeformerContext:
         prior_logits: ``(ΣN, 24)`` the weight head's body-skinning prior
             (:func:`body_prior_logits`, ``-inf`` on joints out of ``weight_reach``), or
             ``None`` when the model has no prior.
+        active_channels: ``(k,)`` long, the columns of ``fused.flatten(1)`` that are
+            non-zero at some vertex, or ``None`` when all are. ``X^fuse`` is a product
+            of ReLU outputs and most of its columns are zero at every vertex (257 of
+            384 for the shipped model on the benchmark skirt): M^mp's input
+            ``flatten(X^fuse) ⊙ E^t2`` is zero there for every frame, so the embedding
+            GATs read only these columns — the same output, and no gradient is lost
+            (a ReLU passes none back through a zero).
     """
 
     fused: torch.Tensor
@@ -55,6 +62,7 @@ class DeformerContext:
     ptr: list[int]
     hierarchies: list[PoolHierarchy]
     prior_logits: torch.Tensor | None = None
+    active_channels: torch.Tensor | None = None
     _graphs: dict[int, GraphLevels] = field(default_factory=dict, repr=False)
 
     @property
@@ -169,7 +177,7 @@ class GarmentDeformer(nn.Module):
                         if self.weight_head.body_prior else None)
         return DeformerContext(fused=fused, rest_pos=torch.cat([p.rest_pos for p in pairs]),
                                ptr=_offsets(sizes), hierarchies=[p.hierarchy for p in pairs],
-                               prior_logits=prior_logits)
+                               prior_logits=prior_logits, active_channels=_active_channels(fused))
 
     # ---------------------------------------------------------------- per frame
     def forward(self, context: DeformerContext, motion_windows: torch.Tensor,
@@ -193,22 +201,25 @@ class GarmentDeformer(nn.Module):
         pose_code = pose_code.view(pairs, frames, width)
         velocity_code = velocity_code.view(pairs, frames, NUM_JOINTS * width)
 
+        active = context.active_channels
+        if active is not None:
+            velocity_code = velocity_code.index_select(2, active)
         weights, processor_input = [], []
         for p in range(pairs):
             fused = context.fused[context.ptr[p]:context.ptr[p + 1]]           # (N, S, F)
             prior = (None if context.prior_logits is None else
                      context.prior_logits[context.ptr[p]:context.ptr[p + 1]])
             weights.append(self.weight_head(fused, pose_code[p], prior).flatten(0, 1))  # Eq. 6
-            processor_input.append(
-                (fused.flatten(1)[None] * velocity_code[p][:, None, :]).flatten(0, 1))  # Eq. 7
+            flat = fused.flatten(1) if active is None else fused.flatten(1).index_select(1, active)
+            processor_input.append((flat[None] * velocity_code[p][:, None, :]).flatten(0, 1))
         weights_all = torch.cat(weights)
-        x = torch.cat(processor_input)
+        x = torch.cat(processor_input)                                         # Eq. 7
 
         graph = self._graph_levels(context, frames, x.device)
-        supervised = self.supervised_processor(x, graph)                       # Eq. 8
+        supervised = self.supervised_processor(x, graph, active)               # Eq. 8
         blend = supervised
         if self.use_physics and self.physics_processor is not None:
-            blend = supervised + self.physics_processor(x, graph)
+            blend = supervised + self.physics_processor(x, graph, active)
 
         sizes = [context.ptr[p + 1] - context.ptr[p] for p in range(pairs)]
         rest = torch.cat([context.rest_pos[context.ptr[p]:context.ptr[p + 1]].repeat(frames, 1)
@@ -234,6 +245,15 @@ class GarmentDeformer(nn.Module):
             graph.unpool = [u.to(device) for u in graph.unpool]
             context._graphs[frames] = graph
         return context._graphs[frames]
+
+
+def _active_channels(fused: torch.Tensor) -> torch.Tensor | None:
+    """``(k,)`` the columns of ``fused.flatten(1)`` non-zero at some vertex (NaN counts as
+    non-zero), or ``None`` when that is all of them. Shapes: fused ``(ΣN, S, F)``."""
+    nonzero = (fused.detach().flatten(1) != 0).any(0)
+    if bool(nonzero.all()):
+        return None
+    return nonzero.nonzero().squeeze(1)
 
 
 def _offsets(sizes: Sequence[int]) -> list[int]:

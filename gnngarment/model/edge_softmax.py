@@ -5,6 +5,8 @@ order of a :class:`~gnngarment.model.attention_graph.HeadLayout`.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import torch
 from torch.nn import functional
 
@@ -67,14 +69,15 @@ def _softmax_shift(scores: torch.Tensor, heads: int, layout: HeadLayout,
 
 
 def _segment_sum(values: torch.Tensor, layout: HeadLayout) -> torch.Tensor:
-    """Softmax denominators ``1e-16 + Σ`` over each segment (scatter_add with an int64
-    index was ~1.7× faster than ``segment_reduce`` on this CPU).
+    """Softmax denominators ``1e-16 + Σ`` over each segment, for every copy (scatter_add
+    with an int64 index was ~1.7× faster than ``segment_reduce`` on this CPU).
 
     Shapes:
-        values ``(E'·H,)`` → ``(N·H,)``.
+        values ``(copies, E'·H)`` → ``(copies, N·H)`` (``layout`` of one copy).
     """
-    total = values.new_full((layout.segment_ptr.shape[0] - 1,), _SOFTMAX_EPS)
-    return total.scatter_add_(0, layout.segment_index, values)
+    copies = values.shape[0]
+    total = values.new_full((copies, layout.segment_ptr.shape[0] - 1), _SOFTMAX_EPS)
+    return total.scatter_add_(1, layout.segment_index.expand(copies, -1), values)
 
 
 def _leaky(value: float, negative_slope: float) -> float:
@@ -82,7 +85,8 @@ def _leaky(value: float, negative_slope: float) -> float:
 
 
 def edge_softmax(scores: torch.Tensor, heads: int, layout: HeadLayout,
-                 negative_slope: float) -> torch.Tensor:
+                 negative_slope: float,
+                 blocks: Sequence[tuple[HeadLayout, int]] | None = None) -> torch.Tensor:
     """Attention coefficients ``softmax_k(leaky_relu(a_src[j_k] + a_dst[i]))`` over the
     incoming edges ``k`` of every target ``i``, per head, in the layout's value order.
 
@@ -90,27 +94,58 @@ def edge_softmax(scores: torch.Tensor, heads: int, layout: HeadLayout,
     value); the shift subtracted before ``exp`` is :func:`_softmax_shift`'s instead of
     the segment max (the same function; see there).
 
+    ``blocks`` describes the graph as runs of identical copies (``(layout of one copy,
+    copies)`` in node order, as
+    :meth:`~gnngarment.model.attention_graph.AttentionGraph.block_layouts` gives them —
+    the frames of one garment). The gathers and sums of every copy then use the one
+    copy's index arrays: the same values, but the indices read are ``copies`` times
+    fewer (at 16 frames of a 5,000-vertex garment, 0.5 MB that stays in cache instead
+    of 35 MB streamed from memory by every layer).
+
     Shapes:
         scores ``(N, 3H)`` (see :func:`_softmax_shift`) → ``(E'·H,)``.
     """
-    source, target = layout.source_slot, layout.target_slot
+    if blocks is None:
+        blocks = [(layout, 1)]
+    nodes_covered = sum(copies * (base.segment_ptr.shape[0] - 1) // heads
+                        for base, copies in blocks)
+    values_covered = sum(copies * base.source_slot.shape[0] for base, copies in blocks)
+    if nodes_covered != scores.shape[0] or values_covered != layout.source_slot.shape[0]:
+        raise ValueError(f"blocks cover {nodes_covered} nodes and {values_covered} values, "
+                         f"the graph has {scores.shape[0]} and {layout.source_slot.shape[0]}")
     shift = _softmax_shift(scores, heads, layout, negative_slope)
-    a_src = scores[:, :heads].reshape(-1)                                      # (N·H,)
-    a_dst = scores[:, heads:2 * heads].reshape(-1)
-    if torch.is_grad_enabled() and scores.requires_grad:
-        logits = functional.leaky_relu(
-            a_src.index_select(0, source) + a_dst.index_select(0, target), negative_slope)
-        weight = (logits if shift is None else logits - shift.index_select(0, target)).exp()
-        total = _segment_sum(weight, layout)
-        return weight / total.index_select(0, target)
-    # Inference: the same operations in place. Every (E'·H,) temporary is tens of MB,
-    # and fresh allocations of that size cost page faults comparable to the arithmetic.
-    logits = a_src.index_select(0, source)
-    logits += a_dst.index_select(0, target)
-    functional.leaky_relu_(logits, negative_slope)
-    if shift is not None:
-        logits -= shift.index_select(0, target)
-    logits.exp_()
-    total = _segment_sum(logits, layout)
-    logits /= total.index_select(0, target)
-    return logits
+    grad = torch.is_grad_enabled() and scores.requires_grad
+    # Inference writes every copy's coefficients in place into one output: every (E'·H,)
+    # temporary is tens of MB, and fresh allocations of that size cost page faults
+    # comparable to the arithmetic.
+    out = None if grad else scores.new_empty(layout.source_slot.shape[0])
+    pieces, node, value = [], 0, 0
+    for base, copies in blocks:
+        nodes = (base.segment_ptr.shape[0] - 1) // heads
+        block = scores[node:node + copies * nodes].view(copies, nodes, 3 * heads)
+        a_src = block[:, :, :heads].reshape(copies, nodes * heads)
+        a_dst = block[:, :, heads:2 * heads].reshape(copies, nodes * heads)
+        block_shift = (None if shift is None else
+                       shift[node * heads:(node + copies * nodes) * heads].view(copies, -1))
+        source, target = base.source_slot, base.target_slot
+        count = copies * source.shape[0]
+        if grad:
+            logits = functional.leaky_relu(
+                a_src.index_select(1, source) + a_dst.index_select(1, target), negative_slope)
+            weight = (logits if block_shift is None else
+                      logits - block_shift.index_select(1, target)).exp()
+            total = _segment_sum(weight, base)
+            pieces.append((weight / total.index_select(1, target)).flatten())
+        else:
+            logits = out[value:value + count].view(copies, -1)
+            torch.index_select(a_src, 1, source, out=logits)
+            logits += a_dst.index_select(1, target)
+            functional.leaky_relu_(logits, negative_slope)
+            if block_shift is not None:
+                logits -= block_shift.index_select(1, target)
+            logits.exp_()
+            total = _segment_sum(logits, base)
+            logits /= total.index_select(1, target)
+        node += copies * nodes
+        value += count
+    return torch.cat(pieces) if grad else out

@@ -72,23 +72,31 @@ class GraphAttention(nn.Module):
         glorot(self.att_dst)
         zeros(self.bias)
 
-    def forward(self, x: torch.Tensor, graph: torch.Tensor | AttentionGraph) -> torch.Tensor:
+    def forward(self, x: torch.Tensor, graph: torch.Tensor | AttentionGraph,
+                input_columns: torch.Tensor | None = None) -> torch.Tensor:
+        """``input_columns`` (``(k,)`` long, optional): ``x`` holds only these columns
+        of the layer's input, every other column being zero; the projection then reads
+        only the matching columns of ``lin.weight`` (the same result up to rounding, at
+        ``k / in_channels`` of the cost). Shapes: ``x (N, k)`` then."""
         if not isinstance(graph, AttentionGraph):
             graph = AttentionGraph.from_edge_index(graph, x.shape[0])
         if graph.num_nodes != x.shape[0]:
             raise ValueError(f"graph has {graph.num_nodes} nodes, x has {x.shape[0]} rows")
         heads, channels = self.heads, self.out_channels
-        h = self.lin(x)
+        weight = (self.lin.weight if input_columns is None
+                  else self.lin.weight.index_select(1, input_columns))
+        h = functional.linear(x, weight)
         # Both attention scores of every node and head in one small GEMM, (N, 3H), in
         # float32 even under autocast (logit errors are amplified by exp).
         if torch.is_autocast_enabled(h.device.type):
             with torch.autocast(h.device.type, enabled=False):
                 h = h.float()
-                scores = self._scores(x.float(), h)
+                scores = self._scores(x.float(), h, weight.float())
         else:
-            scores = self._scores(x, h)
+            scores = self._scores(x, h, weight)
         layout = graph.layout(heads)
-        alpha = edge_softmax(scores, heads, layout, self.negative_slope)
+        alpha = edge_softmax(scores, heads, layout, self.negative_slope,
+                             graph.block_layouts(heads))
         if self.dropout > 0 and self.training:
             alpha = functional.dropout(alpha, self.dropout, training=True)
         dense = h.view(-1, channels)                                          # (N·H, C)
@@ -103,19 +111,22 @@ class GraphAttention(nn.Module):
             return out.add_(self.bias)
         # Inference: one product writes bias + scale · A @ dense into a bias-filled output
         # (saves two passes over the output).
-        out = self.bias.to(dense.dtype).repeat(x.shape[0], 1).view(-1, channels)  # a copy
+        rows = x.shape[0] * (heads if self.concat else 1)
+        out = torch.empty(rows, channels, dtype=dense.dtype, device=dense.device)
+        out.view(x.shape[0], -1).copy_(self.bias.to(dense.dtype).expand(x.shape[0], -1))
         torch.addmm(out, pattern.matrix(alpha), dense, beta=1.0, alpha=scale, out=out)
         return out.view(x.shape[0], -1)
 
-    def _scores(self, x: torch.Tensor, h: torch.Tensor) -> torch.Tensor:
+    def _scores(self, x: torch.Tensor, h: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:
         """``(N, 3H)``: ``a_src = <h_i,h, att_src_h>``, ``a_dst`` and their sum (the
         self-loop logit before LeakyReLU, for
         :func:`~gnngarment.model.edge_softmax._softmax_shift`), from whichever of
         ``x`` and ``h = x W^T`` is narrower (a skinny GEMM reading ``(N, 32)`` instead of
-        ``(N, 128)`` was ~5× faster; ``x (W^T M) = (x W^T) M`` up to rounding)."""
+        ``(N, 128)`` was ~5× faster; ``x (W^T M) = (x W^T) M`` up to rounding); ``weight``
+        is the projection ``h = x weight^T`` used (``lin.weight`` or its input columns)."""
         matrix = self._score_matrix()
-        if self.in_channels < self.heads * self.out_channels:
-            return x @ (self.lin.weight.t().to(matrix.dtype) @ matrix)
+        if x.shape[1] < self.heads * self.out_channels:
+            return x @ (weight.t().to(matrix.dtype) @ matrix)
         return h @ matrix
 
     def _score_matrix(self) -> torch.Tensor:
@@ -165,16 +176,23 @@ def set_attention(module: nn.Module, attention: str) -> nn.Module:
 
 
 def apply_attention(layer: nn.Module, x: torch.Tensor, edge_index: torch.Tensor,
-                    graph: AttentionGraph | Callable[[], AttentionGraph]) -> torch.Tensor:
+                    graph: AttentionGraph | Callable[[], AttentionGraph],
+                    input_columns: torch.Tensor | None = None) -> torch.Tensor:
     """Run a GAT layer of either implementation on one graph.
 
     PyG's ``GATConv`` gets ``edge_index``; :class:`GraphAttention` gets the prebuilt
     structure (``graph``, or ``graph()`` for a structure that is built lazily, so that
-    the PyG path never pays for building it).
+    the PyG path never pays for building it). ``input_columns``: ``x`` holds only these
+    columns of the input, the others are zero (see :meth:`GraphAttention.forward`;
+    ``GATConv`` gets the zeros put back).
 
     Shapes:
-        x ``(N, in)``, edge_index ``(2, E)`` → the layer's output.
+        x ``(N, in)`` (``(N, k)`` with ``input_columns``), edge_index ``(2, E)`` → the
+        layer's output.
     """
     if isinstance(layer, GraphAttention):
-        return layer(x, graph if isinstance(graph, AttentionGraph) else graph())
+        return layer(x, graph if isinstance(graph, AttentionGraph) else graph(),
+                     input_columns)
+    if input_columns is not None:
+        x = x.new_zeros(x.shape[0], layer.in_channels).index_copy(1, input_columns, x)
     return layer(x, edge_index)

@@ -25,6 +25,9 @@ class GraphLevels:
         kept: per pooling step ``l -> l + 1``, ``(N_{l+1},)`` long indices into level ``l``.
         unpool: per pooling step, ``(N_l, N_{l+1})`` sparse (COO) unpooling operator.
         num_graphs: graphs in the batch.
+        runs: ``(hierarchy, copies)`` runs of consecutive graphs that are one garment's
+            copies (its frames), in order; their attention structures are built as
+            repeated copies (:meth:`AttentionGraph.repeated`).
 
     The attention structure of every level (:meth:`attention_graph`) and the CSR form
     of every unpooling operator (:meth:`unpool_operator`) are built on first use and
@@ -37,6 +40,7 @@ class GraphLevels:
     kept: list[torch.Tensor]
     unpool: list[torch.Tensor]
     num_graphs: int
+    runs: list[tuple[PoolHierarchy, int]] = field(default_factory=list)
     _attention: dict[int, tuple[torch.Tensor, AttentionGraph]] = field(
         default_factory=dict, init=False, repr=False)
     _unpool: dict[int, tuple[torch.Tensor, SparseOperator]] = field(
@@ -52,8 +56,18 @@ class GraphLevels:
         edge_index = self.edge_index[level]
         cached = self._attention.get(level)
         if cached is None or cached[0] is not edge_index:
-            cached = (edge_index, AttentionGraph.from_edge_index(
-                edge_index, int(self.batch[level].shape[0])))
+            num_nodes = int(self.batch[level].shape[0])
+            if self.runs and any(copies > 1 for _, copies in self.runs):
+                graph = AttentionGraph.repeated([
+                    (_level_graph(hierarchy, level, edge_index.device), copies)
+                    for hierarchy, copies in self.runs])
+                edges = sum(copies * _level_edges(hierarchy, level).shape[1]
+                            for hierarchy, copies in self.runs)
+                if graph.num_nodes != num_nodes or edges != edge_index.shape[1]:
+                    raise ValueError(f"level {level}: runs do not describe edge_index")
+            else:
+                graph = AttentionGraph.from_edge_index(edge_index, num_nodes)
+            cached = (edge_index, graph)
             self._attention[level] = cached
         return cached[1]
 
@@ -66,6 +80,19 @@ class GraphLevels:
             cached = (matrix, SparseOperator(matrix))
             self._unpool[step] = cached
         return cached[1]
+
+
+def _level_graph(hierarchy: PoolHierarchy, level: int, device: torch.device) -> AttentionGraph:
+    """One copy's attention graph at ``level`` (0: the garment, ``l``: its ``l``-th
+    pooled graph)."""
+    nodes = hierarchy.num_vertices if level == 0 else hierarchy.levels[level - 1].num_vertices
+    return AttentionGraph.from_edge_index(
+        torch.as_tensor(_level_edges(hierarchy, level), device=device), nodes)
+
+
+def _level_edges(hierarchy: PoolHierarchy, level: int) -> np.ndarray:
+    """``(2, E)`` the hierarchy's edges at ``level``."""
+    return hierarchy.edge_index if level == 0 else hierarchy.levels[level - 1].edge_index
 
 
 def _to_torch_sparse(matrix: sp.spmatrix) -> torch.Tensor:
@@ -103,8 +130,7 @@ def stack_hierarchies(hierarchies: Sequence[PoolHierarchy], depth: int) -> Graph
     for level in range(depth + 1):
         pieces = []
         for g, hierarchy in enumerate(hierarchies):
-            edges = hierarchy.edge_index if level == 0 else hierarchy.levels[level - 1].edge_index
-            pieces.append(edges + offsets[g, level])
+            pieces.append(_level_edges(hierarchy, level) + offsets[g, level])
         edge_index.append(torch.from_numpy(np.concatenate(pieces, axis=1)))
         batch.append(torch.from_numpy(np.repeat(np.arange(len(hierarchies)), counts[:, level])))
     for step in range(depth):
@@ -112,5 +138,11 @@ def stack_hierarchies(hierarchies: Sequence[PoolHierarchy], depth: int) -> Graph
             [h.levels[step].kept + offsets[g, step] for g, h in enumerate(hierarchies)])))
         unpool.append(_to_torch_sparse(sp.block_diag([h.levels[step].unpool for h in hierarchies],
                                                   format="csr")))
+    runs: list[tuple[PoolHierarchy, int]] = []
+    for hierarchy in hierarchies:
+        if runs and runs[-1][0] is hierarchy:
+            runs[-1] = (hierarchy, runs[-1][1] + 1)
+        else:
+            runs.append((hierarchy, 1))
     return GraphLevels(edge_index=edge_index, batch=batch, kept=kept, unpool=unpool,
-                       num_graphs=len(hierarchies))
+                       num_graphs=len(hierarchies), runs=runs)

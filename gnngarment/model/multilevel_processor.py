@@ -26,9 +26,14 @@ class MultilevelProcessor(nn.Module):
     structure of each level is built once per :class:`GraphLevels` and shared by all the
     layers of that level (embedding, decoder and output at level 0).
 
+    ``input_columns`` (``(k,)`` long, optional) says that ``x`` holds only these input
+    columns and all others are zero: the embedding GAT then reads only them (the same
+    result; the deformer's input is mostly zero columns, see
+    :attr:`~gnngarment.model.deformer.DeformerContext.active_channels`).
+
     Shapes:
-        x ``(N, in_channels)`` with ``graph`` describing ``N`` vertices at level 0
-        → ``(N, out_channels)``.
+        x ``(N, in_channels)`` (``(N, k)`` with ``input_columns``) with ``graph``
+        describing ``N`` vertices at level 0 → ``(N, out_channels)``.
     """
 
     def __init__(self, in_channels: int, channels: int, heads: int, out_channels: int,
@@ -58,19 +63,22 @@ class MultilevelProcessor(nn.Module):
                 else:
                     raise ValueError(f"unknown pooling '{pooling}'")
 
-    def forward(self, x: torch.Tensor, graph: GraphLevels) -> torch.Tensor:
+    def forward(self, x: torch.Tensor, graph: GraphLevels,
+                input_columns: torch.Tensor | None = None) -> torch.Tensor:
         if self.pooling == "structure":
-            return self._forward_structure(x, graph)
-        return self._forward_learned(x, graph)
+            return self._forward_structure(x, graph, input_columns)
+        return self._forward_learned(x, graph, input_columns)
 
-    def _forward_structure(self, x: torch.Tensor, graph: GraphLevels) -> torch.Tensor:
-        def gat(layer: nn.Module, features: torch.Tensor, level: int) -> torch.Tensor:
+    def _forward_structure(self, x: torch.Tensor, graph: GraphLevels,
+                           input_columns: torch.Tensor | None) -> torch.Tensor:
+        def gat(layer: nn.Module, features: torch.Tensor, level: int,
+                columns: torch.Tensor | None = None) -> torch.Tensor:
             return apply_attention(layer, features, graph.edge_index[level],
-                                   lambda: graph.attention_graph(level))
+                                   lambda: graph.attention_graph(level), columns)
 
         # tanh_ and add_ in place: the GAT and unpooling outputs are fresh tensors that
         # nothing else reads, and each saved a (N, channels) allocation per layer.
-        x = gat(self.embedding, x, 0).tanh_()
+        x = gat(self.embedding, x, 0, input_columns).tanh_()
         skips: list[torch.Tensor] = []
         for level in range(self.levels):
             skips.append(x)
@@ -80,22 +88,23 @@ class MultilevelProcessor(nn.Module):
             x = gat(self.decoders[level], up, level).tanh_()
         return gat(self.output, x, 0)
 
-    def _forward_learned(self, x: torch.Tensor, graph: GraphLevels) -> torch.Tensor:
+    def _forward_learned(self, x: torch.Tensor, graph: GraphLevels,
+                         input_columns: torch.Tensor | None) -> torch.Tensor:
         # Pooling by score changes the coarse graphs on every call: their attention
         # structures are built per call, once per level, shared by its encoder and decoder.
         edge_index, batch = graph.edge_index[0], graph.batch[0]
         structures: dict[int, AttentionGraph] = {}
 
         def gat(layer: nn.Module, features: torch.Tensor, edges: torch.Tensor,
-                level: int) -> torch.Tensor:
+                level: int, columns: torch.Tensor | None = None) -> torch.Tensor:
             def build() -> AttentionGraph:
                 if level not in structures:
                     structures[level] = (graph.attention_graph(0) if level == 0 else
                                          AttentionGraph.from_edge_index(edges, features.shape[0]))
                 return structures[level]
-            return apply_attention(layer, features, edges, build)
+            return apply_attention(layer, features, edges, build, columns)
 
-        x = torch.tanh(gat(self.embedding, x, edge_index, 0))
+        x = torch.tanh(gat(self.embedding, x, edge_index, 0, input_columns))
         skips: list[tuple[torch.Tensor, torch.Tensor, torch.Tensor]] = []
         for level in range(self.levels):
             pooled = self.poolers[level](x, edge_index, batch=batch)

@@ -29,3 +29,24 @@ def test_only_self_loops_and_bad_indices() -> None:
         AttentionGraph.from_edge_index(torch.tensor([[0], [5]]), 5)
     with pytest.raises(ValueError, match="nodes"):
         layer(torch.randn(4, 3), AttentionGraph.from_edge_index(empty, 5))
+
+
+def test_repeated_copies_equal_the_offset_edge_list() -> None:
+    # The frames of a garment: copies of one graph numbered copy by copy. The repeated
+    # build must give exactly the structure of the stacked edge list, and know its blocks.
+    first, second = random_graph(seed=1), random_graph(seed=2, num_nodes=30, connected=20,
+                                                          edges=80)
+    blocks = [(AttentionGraph.from_edge_index(first, 60), 3),
+              (AttentionGraph.from_edge_index(second, 30), 2)]
+    offsets = [0, 60, 120, 180, 210]
+    stacked = torch.cat([first + offsets[c] for c in range(3)]
+                        + [second + offsets[3 + c] for c in range(2)], dim=1)
+    expected = AttentionGraph.from_edge_index(stacked, 240)
+    repeated = AttentionGraph.repeated(blocks)
+    assert repeated.num_nodes == 240
+    assert torch.equal(repeated.ptr, expected.ptr)
+    assert torch.equal(repeated.source, expected.source)
+    assert repeated.blocks is not None and [c for _, c in repeated.blocks] == [3, 2]
+    layouts = repeated.block_layouts(4)
+    assert layouts is not None and layouts[0][0] is blocks[0][0].layout(4)
+    assert expected.block_layouts(4) is None

@@ -10,8 +10,8 @@ import pytest
 import torch
 
 from gnngarment.config import load_config
-from gnngarment.model import POOLING_METHODS, GarmentDeformer, ModelConfig
-from gnngarment.paths import default_config
+from gnngarment.model import POOLING_METHODS, GarmentDeformer, ModelConfig, stack_hierarchies
+from gnngarment.paths import SHIPPED_MODEL, default_config
 from tests.meshes import interleave, random_disk, tube
 from tests.model.pairs import frame_inputs, make_pair, tiny_config
 
@@ -203,3 +203,67 @@ def test_shipped_model_configs_load_and_validate(name: str) -> None:
     config.validate()
     if name == "paper.yaml":
         assert asdict(config) == asdict(ModelConfig())
+
+
+def reference_forward(model: GarmentDeformer, context, inputs):
+    """The forward without either inference shortcut: M^mp reads every input column,
+    and the frames' attention graphs are built as one plain edge list."""
+    frames = inputs[0].shape[1]
+    plain = replace(context, active_channels=None)
+    plain._graphs = {}
+    graph = stack_hierarchies([h for h in context.hierarchies for _ in range(frames)],
+                              model.config.levels)
+    graph.runs = []
+    plain._graphs[frames] = graph
+    return model(plain, *inputs)
+
+
+def test_zero_columns_and_shared_frame_structure_change_nothing(garments) -> None:
+    # Both shortcuts of the per-frame pass (skipping X^fuse's all-zero columns; one
+    # copy's indices for every frame's edge softmax) give the reference's outputs and,
+    # in training, its gradients, for a batch of two garments × three frames.
+    model = build(tiny_config())
+    model.train()
+    model.use_physics = True
+    with torch.no_grad():
+        model.physics_processor.output.lin.weight.normal_(std=0.1)
+    pairs = [make_pair(*garments["disk"], model.config),
+             make_pair(*garments["tube"], model.config, seed=1)]
+    inputs = frame_inputs(model.config, 2, 3)
+    context = model.encode(pairs)
+    assert context.active_channels is not None  # the shortcut is exercised
+    assert len(context.active_channels) < context.fused[0].numel()
+    actual = model(context, *inputs)
+    actual_grads = torch.autograd.grad(actual.posed.square().sum(), list(model.parameters()),
+                                       allow_unused=True)
+    context = model.encode(pairs)
+    expected = reference_forward(model, context, inputs)
+    expected_grads = torch.autograd.grad(expected.posed.square().sum(),
+                                         list(model.parameters()), allow_unused=True)
+    for name in ("posed", "weights", "blend_shapes"):
+        torch.testing.assert_close(getattr(actual, name), getattr(expected, name),
+                                   rtol=1e-5, atol=1e-6, msg=name)
+    for (name, _), a, e in zip(model.named_parameters(), actual_grads, expected_grads,
+                               strict=True):
+        if e is None:
+            assert a is None or not a.any(), name
+        else:
+            torch.testing.assert_close(a, e, rtol=1e-4, atol=1e-6, msg=name)
+
+
+def test_shipped_model_posed_vertices_equal_the_reference_path() -> None:
+    # Issue 14's bar: the fast inference path poses the vertices of the shipped model
+    # within 1e-5 m of the reference path (16 frames of a 3,000-vertex skirt).
+    from data_prep.garments.skirt import flared_skirt
+    from gnngarment.model.checkpoint import load_model
+
+    model = load_model(SHIPPED_MODEL)
+    model.use_physics = True
+    pos, faces = flared_skirt(3000)
+    pair = make_pair(pos, faces, model.config, levels=model.config.levels)
+    inputs = frame_inputs(model.config, 1, 16)
+    with torch.inference_mode():
+        context = model.encode([pair])
+        actual = model(context, *inputs).posed
+        expected = reference_forward(model, model.encode([pair]), inputs).posed
+    assert float((actual - expected).abs().max()) < 1e-5

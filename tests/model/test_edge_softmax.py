@@ -6,7 +6,7 @@ import pytest
 import torch
 
 from gnngarment.model.attention_graph import AttentionGraph
-from gnngarment.model.edge_softmax import _MAX_SHIFT_GAP, _softmax_shift
+from gnngarment.model.edge_softmax import _MAX_SHIFT_GAP, _softmax_shift, edge_softmax
 from tests.model.attention_cases import (
     assert_relative,
     outputs_and_gradients,
@@ -62,3 +62,32 @@ def test_softmax_shift_keeps_exp_in_range(case: str) -> None:
     assert (shift - exact).max() <= _MAX_SHIFT_GAP     # denominators stay >= e^-20
     if case == "exact":
         torch.testing.assert_close(shift, exact, rtol=0, atol=0)
+
+
+@pytest.mark.parametrize("grad", [False, True])
+def test_repeated_blocks_give_the_same_coefficients(grad: bool) -> None:
+    # Gathering every copy with one copy's indices is a different computation of the
+    # same coefficients, with and without autograd.
+    first, second = random_graph(seed=1), random_graph(seed=2, num_nodes=30, connected=20,
+                                                          edges=80)
+    base = [(AttentionGraph.from_edge_index(first, 60), 3),
+            (AttentionGraph.from_edge_index(second, 30), 2)]
+    repeated = AttentionGraph.repeated(base)
+    plain = AttentionGraph.from_edge_index(repeated.edge_index, repeated.num_nodes)
+    heads = 3
+    scores = torch.randn(240, 3 * heads, generator=torch.Generator().manual_seed(7))
+    scores[:, 2 * heads:] = scores[:, :heads] + scores[:, heads:2 * heads]
+    scores.requires_grad_(grad)
+    with torch.set_grad_enabled(grad):
+        expected = edge_softmax(scores, heads, plain.layout(heads), 0.2)
+        actual = edge_softmax(scores, heads, repeated.layout(heads), 0.2,
+                              repeated.block_layouts(heads))
+    torch.testing.assert_close(actual, expected, rtol=1e-6, atol=1e-7)
+    if grad:
+        weight = torch.randn(expected.shape, generator=torch.Generator().manual_seed(8))
+        (expected_grad,) = torch.autograd.grad((expected * weight).sum(), scores)
+        (actual_grad,) = torch.autograd.grad((actual * weight).sum(), scores)
+        torch.testing.assert_close(actual_grad, expected_grad, rtol=1e-5, atol=1e-6)
+    with pytest.raises(ValueError, match="blocks cover"):
+        edge_softmax(scores.detach()[:180], heads, plain.layout(heads), 0.2,
+                     repeated.block_layouts(heads))

@@ -9,7 +9,12 @@ from torch_geometric.nn import GATConv
 from gnngarment.geometry import edge_index_from_faces, pool_hierarchy
 from gnngarment.model import GarmentDeformer, MultilevelProcessor, stack_hierarchies
 from gnngarment.model.attention_graph import AttentionGraph
-from gnngarment.model.graph_attention import GraphAttention, graph_attention, set_attention
+from gnngarment.model.graph_attention import (
+    GraphAttention,
+    apply_attention,
+    graph_attention,
+    set_attention,
+)
 from tests.meshes import random_disk, tube
 from tests.model.attention_cases import (
     TOLERANCE,
@@ -200,3 +205,29 @@ def test_the_model_config_picks_the_attention_implementation() -> None:
         model = GarmentDeformer(tiny_config(attention=attention))
         layers = [m for m in model.modules() if isinstance(m, GATConv | GraphAttention)]
         assert layers and all(isinstance(m, layer_type) for m in layers), attention
+
+
+@pytest.mark.parametrize("attention", ["csr", "pyg"])
+@pytest.mark.parametrize("in_channels", [6, 20])  # narrower / wider than heads × out
+def test_input_columns_equal_the_zero_padded_input(attention: str, in_channels: int) -> None:
+    # An input whose other columns are zero, given as its non-zero columns only: the
+    # same output, and the same gradients for the parameters and the given columns.
+    torch.manual_seed(3)
+    layer = graph_attention(in_channels, 4, 3, concat=False, attention=attention)
+    edge_index = random_graph(seed=4)
+    graph = AttentionGraph.from_edge_index(edge_index, 60)
+    columns = torch.tensor([0, 2, 5])
+    narrow = torch.randn(60, 3, requires_grad=True)
+    full = torch.zeros(60, in_channels).index_copy(1, columns, narrow.detach())
+    full.requires_grad_(True)
+    weight = torch.randn(60, 4)
+    expected = apply_attention(layer, full, edge_index, graph)
+    (expected * weight).sum().backward()
+    expected_grads = {name: p.grad.clone() for name, p in layer.named_parameters()}
+    layer.zero_grad()
+    actual = apply_attention(layer, narrow, edge_index, graph, columns)
+    (actual * weight).sum().backward()
+    torch.testing.assert_close(actual, expected, **TOLERANCE)
+    torch.testing.assert_close(narrow.grad, full.grad[:, columns], **TOLERANCE)
+    for name, p in layer.named_parameters():
+        torch.testing.assert_close(p.grad, expected_grads[name], **TOLERANCE, msg=name)
