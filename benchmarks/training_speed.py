@@ -11,6 +11,10 @@ mixed garments).
     .venv/bin/python benchmarks/training_speed.py [--config configs/train/demo.yaml]
         [--data data/demo] [--steps 10] [--threads 1] [--deterministic on|off|both]
 
+Freed memory is kept for reuse as every ``gnngarment`` command keeps it
+(:func:`gnngarment.allocator.keep_freed_memory`); ``GNNGARMENT_KEEP_FREED_MEMORY=0``
+measures with glibc's defaults.
+
 ``--deterministic both`` measures the run with torch's deterministic algorithms off and
 on (the training default), in that order in one process, and prints the ratio.
 
@@ -33,6 +37,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from gnngarment.allocator import keep_freed_memory  # noqa: E402
 from gnngarment.data import PreparedDataset  # noqa: E402
 from gnngarment.training.loading import load_training_config  # noqa: E402
 from gnngarment.training.trainer import Trainer, set_stage  # noqa: E402
@@ -90,8 +95,11 @@ def main() -> None:
         print(f"{args.data}: no prepared cache (build it with `gnngarment prepare --config "
               "configs/data/demo.yaml`, or `make demo`)", file=sys.stderr)
         raise SystemExit(2)
+    # As `gnngarment train` does (GNNGARMENT_KEEP_FREED_MEMORY=0: glibc's defaults).
+    kept = keep_freed_memory()
     print(f"torch {torch.__version__}, {args.threads} thread(s), load average "
-          f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+          f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores, freed memory "
+          f"{'kept for reuse' if kept else 'unmapped (glibc default)'}")
     modes = {"on": [True], "off": [False], "both": [False, True]}[args.deterministic]
     runs = [measure(args.config, args.data, args.steps, args.threads, mode) for mode in modes]
     for results in runs:
