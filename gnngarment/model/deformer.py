@@ -212,8 +212,9 @@ class GarmentDeformer(nn.Module):
             weights.append(self.weight_head(fused, pose_code[p], prior).flatten(0, 1))  # Eq. 6
             flat = fused.flatten(1) if active is None else fused.flatten(1).index_select(1, active)
             processor_input.append((flat[None] * velocity_code[p][:, None, :]).flatten(0, 1))
-        weights_all = torch.cat(weights)
-        x = torch.cat(processor_input)                                         # Eq. 7
+        # One pair (inference): its tensors as they are (cat would copy the (B·N, k) input).
+        weights_all = weights[0] if pairs == 1 else torch.cat(weights)
+        x = processor_input[0] if pairs == 1 else torch.cat(processor_input)   # Eq. 7
 
         graph = self._graph_levels(context, frames, x.device)
         supervised = self.supervised_processor(x, graph, active)               # Eq. 8
