@@ -162,6 +162,8 @@ class AttentionGraph:
         return self._layouts[heads]
 
     def _build_layout(self, heads: int) -> HeadLayout:
+        if self.blocks is not None:
+            return self._assemble_layout(heads)
         n, h_count, device = self.num_nodes, heads, self.device
         degree = self.ptr[1:] - self.ptr[:-1]                                  # (N,)
         target = torch.repeat_interleave(torch.arange(n, device=device), degree)  # (E',)
@@ -187,4 +189,45 @@ class AttentionGraph:
             segment_ptr=segment_ptr,
             head_rows=CsrPattern(segment_ptr.to(index_type), col, (n * h_count, n * h_count)),
             node_rows=CsrPattern(node_ptr.to(index_type), col, (n, n * h_count)),
+        )
+
+    def _assemble_layout(self, heads: int) -> HeadLayout:
+        """The layout of a graph of repeated copies, from each block's own layout (built
+        once per block graph) offset copy by copy: no sort, and the CSR patterns know
+        their blocks, so that their transposes are assembled the same way."""
+        device = self.device
+        total = sum(copies * graph.num_edges for graph, copies in self.blocks or ()) * heads
+        # Offsets added in the index type itself: one pass per array, no int64 detour.
+        index_type = torch.int32 if total <= INT32_MAX else torch.int64
+        zero = torch.zeros(1, dtype=index_type, device=device)
+        sources, targets, segments, nodes_ptr = [], [], [zero], [zero]
+        head_blocks, node_blocks = [], []
+        node = value = 0
+        for graph, copies in self.blocks or ():
+            layout = graph.layout(heads)
+            copy = torch.arange(copies, device=device, dtype=index_type)[:, None]
+            slots = node * heads + copy * (graph.num_nodes * heads)
+            values = value + copy * (graph.num_edges * heads)
+            sources.append((layout.source_slot.to(index_type)[None] + slots).flatten())
+            targets.append((layout.target_slot.to(index_type)[None] + slots).flatten())
+            segments.append((layout.head_rows.crow.to(index_type)[None, 1:]
+                             + values).flatten())
+            nodes_ptr.append((layout.node_rows.crow.to(index_type)[None, 1:]
+                              + values).flatten())
+            head_blocks.append((layout.head_rows, copies))
+            node_blocks.append((layout.node_rows, copies))
+            node += copies * graph.num_nodes
+            value += copies * graph.num_edges * heads
+        n = self.num_nodes
+        target_slot = torch.cat(targets)
+        segment_ptr = torch.cat(segments)
+        col = torch.cat(sources)
+        return HeadLayout(
+            source_slot=col,
+            target_slot=target_slot,
+            segment_index=target_slot.long(),
+            segment_ptr=segment_ptr.long(),
+            head_rows=CsrPattern(segment_ptr, col, (n * heads, n * heads), tuple(head_blocks)),
+            node_rows=CsrPattern(torch.cat(nodes_ptr), col, (n, n * heads),
+                                 tuple(node_blocks)),
         )

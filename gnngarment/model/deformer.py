@@ -20,10 +20,11 @@ from gnngarment.body.skinning import skin
 from gnngarment.data.pair import GarmentBodyPair
 from gnngarment.data.vertex_features import VERTEX_FEATURE_CHANNELS
 from gnngarment.geometry.hierarchy import PoolHierarchy
+from gnngarment.model.attention_graph import AttentionGraph
 from gnngarment.model.body_shape_encoder import BodyShapeEncoder
 from gnngarment.model.config import ModelConfig
 from gnngarment.model.garment_encoder import GarmentGraphEncoder
-from gnngarment.model.graph_levels import GraphLevels, stack_hierarchies
+from gnngarment.model.graph_levels import GraphLevels, level_graph, stack_hierarchies
 from gnngarment.model.motion_encoder import MotionEncoder
 from gnngarment.model.multilevel_processor import MultilevelProcessor
 from gnngarment.model.skinning_weight_head import SkinningWeightHead, body_prior_logits
@@ -168,7 +169,12 @@ class GarmentDeformer(nn.Module):
         pair_of_vertex = torch.repeat_interleave(torch.arange(len(pairs), device=device),
                                                  torch.tensor(sizes, device=device))
         style = self.style_encoder(torch.stack([pair.descriptor for pair in pairs]))
-        garment = self.garment_encoder(features, edge_index, style[pair_of_vertex])
+        # The garments' own structures, kept between calls (a training run sees the same
+        # garments batch after batch; see graph_levels.level_graph).
+        structure = (AttentionGraph.repeated([(level_graph(pair.hierarchy, 0, device), 1)
+                                              for pair in pairs])
+                     if self.config.attention == "csr" else None)
+        garment = self.garment_encoder(features, edge_index, style[pair_of_vertex], structure)
         body = self.body_encoder(torch.stack([pair.body_distances for pair in pairs]))
         fused = garment * body[pair_of_vertex]
         # Checked above: every pair has body weights when the head has the prior.

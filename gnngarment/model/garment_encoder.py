@@ -38,8 +38,11 @@ class GarmentGraphEncoder(nn.Module):
             width = heads * out
 
     def forward(self, x: torch.Tensor, edge_index: torch.Tensor,
-                style: torch.Tensor) -> torch.Tensor:
-        structure: list[AttentionGraph] = []
+                style: torch.Tensor, attention_graph: AttentionGraph | None = None
+                ) -> torch.Tensor:
+        """``attention_graph``: ``edge_index``'s structure when the caller has it (built
+        from ``edge_index`` otherwise)."""
+        structure: list[AttentionGraph] = [] if attention_graph is None else [attention_graph]
 
         def graph() -> AttentionGraph:
             if not structure:

@@ -3,6 +3,8 @@ graph per level, as PyG's ``Batch`` does for one level."""
 
 from __future__ import annotations
 
+import weakref
+from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -59,7 +61,7 @@ class GraphLevels:
             num_nodes = int(self.batch[level].shape[0])
             if self.runs and any(copies > 1 for _, copies in self.runs):
                 graph = AttentionGraph.repeated([
-                    (_level_graph(hierarchy, level, edge_index.device), copies)
+                    (level_graph(hierarchy, level, edge_index.device), copies)
                     for hierarchy, copies in self.runs])
                 edges = sum(copies * _level_edges(hierarchy, level).shape[1]
                             for hierarchy, copies in self.runs)
@@ -82,12 +84,34 @@ class GraphLevels:
         return cached[1]
 
 
-def _level_graph(hierarchy: PoolHierarchy, level: int, device: torch.device) -> AttentionGraph:
+#: Garment hierarchies whose attention graphs (with their layouts and transposes, built
+#: on first use) are kept between calls: a training run sees the same garments batch
+#: after batch, and rebuilding them was ~20 % of a supervised step (docs/performance.md,
+#: item 11). Least recently used first out; at 10k vertices one garment's structures for
+#: 4 and 24 heads are ~60 MB, hence the small bound.
+CACHED_HIERARCHIES = 32
+_level_graphs: OrderedDict[int, tuple[weakref.ref, dict]] = OrderedDict()
+
+
+def level_graph(hierarchy: PoolHierarchy, level: int, device: torch.device) -> AttentionGraph:
     """One copy's attention graph at ``level`` (0: the garment, ``l``: its ``l``-th
-    pooled graph)."""
-    nodes = hierarchy.num_vertices if level == 0 else hierarchy.levels[level - 1].num_vertices
-    return AttentionGraph.from_edge_index(
-        torch.as_tensor(_level_edges(hierarchy, level), device=device), nodes)
+    pooled graph), the same object for the same hierarchy while it stays among the
+    :data:`CACHED_HIERARCHIES` most recently used."""
+    key = id(hierarchy)
+    entry = _level_graphs.get(key)
+    if entry is None or entry[0]() is not hierarchy:
+        entry = (weakref.ref(hierarchy), {})
+        _level_graphs[key] = entry
+        while len(_level_graphs) > CACHED_HIERARCHIES:
+            _level_graphs.popitem(last=False)
+    _level_graphs.move_to_end(key)
+    graphs = entry[1]
+    if (level, str(device)) not in graphs:
+        nodes = (hierarchy.num_vertices if level == 0
+                 else hierarchy.levels[level - 1].num_vertices)
+        graphs[(level, str(device))] = AttentionGraph.from_edge_index(
+            torch.as_tensor(_level_edges(hierarchy, level), device=device), nodes)
+    return graphs[(level, str(device))]
 
 
 def _level_edges(hierarchy: PoolHierarchy, level: int) -> np.ndarray:

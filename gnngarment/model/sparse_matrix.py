@@ -50,6 +50,10 @@ class CsrPattern:
     crow: torch.Tensor
     col: torch.Tensor
     shape: tuple[int, int]
+    #: ``((pattern, copies), ...)`` when this pattern is the block diagonal of ``copies``
+    #: copies of each ``pattern`` in turn: its transpose is then assembled from theirs
+    #: (built once per pattern) instead of sorted afresh.
+    blocks: tuple[tuple[CsrPattern, int], ...] | None = None
     _transpose: tuple[torch.Tensor, torch.Tensor, torch.Tensor] | None = field(
         default=None, repr=False)
 
@@ -58,14 +62,20 @@ class CsrPattern:
 
     def transposed(self, values: torch.Tensor) -> torch.Tensor:
         """The transpose with the same values (for the backward pass; built once)."""
+        perm, crow_t, col_t = self.transpose_structure()
+        return _csr(crow_t, col_t, values[perm], (self.shape[1], self.shape[0]))
+
+    def transpose_structure(self) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """``(perm, crow_t, col_t)`` of the transpose (built on first use, cached)."""
         if self._transpose is None:
             with structure_mode():
                 self._transpose = self._build_transpose()
-        perm, crow_t, col_t = self._transpose
-        return _csr(crow_t, col_t, values[perm], (self.shape[1], self.shape[0]))
+        return self._transpose
 
     def _build_transpose(self) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         """``(perm, crow_t, col_t)``: the transpose's values are ``values[perm]``."""
+        if self.blocks is not None:
+            return self._assemble_transpose()
         rows, cols = self.shape
         lengths = (self.crow[1:] - self.crow[:-1]).long()
         row = torch.repeat_interleave(torch.arange(rows, device=self.col.device), lengths)
@@ -78,6 +88,29 @@ class CsrPattern:
         counts = torch.bincount(col, minlength=cols)
         crow_t = torch.cat([counts.new_zeros(1), torch.cumsum(counts, 0)])
         return perm, crow_t.to(self.crow.dtype), row[perm].to(self.col.dtype)
+
+    def _assemble_transpose(self) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """The transpose of a block diagonal is the block diagonal of the transposes:
+        every block's, offset by the values and rows before it."""
+        device = self.col.device
+        index_type = self.col.dtype  # offsets added in it: one pass per array
+        perms, crows, cols = [], [torch.zeros(1, dtype=self.crow.dtype, device=device)], []
+        values = rows = 0
+        for pattern, copies in self.blocks or ():
+            perm, crow_t, col_t = pattern.transpose_structure()
+            nnz = int(pattern.col.shape[0])
+            copy = torch.arange(copies, device=device, dtype=index_type)[:, None]
+            perms.append((perm[None] + (values + copy.long() * nnz)).flatten())
+            crows.append((crow_t.to(self.crow.dtype)[None, 1:] + (values + copy * nnz))
+                         .flatten())
+            cols.append((col_t.to(index_type)[None] + (rows + copy * pattern.shape[0]))
+                        .flatten())
+            values += copies * nnz
+            rows += copies * pattern.shape[0]
+        if values != self.col.shape[0] or rows != self.shape[0]:
+            raise ValueError(f"blocks cover {values} values and {rows} rows, the pattern "
+                             f"has {self.col.shape[0]} and {self.shape[0]}")
+        return torch.cat(perms), torch.cat(crows), torch.cat(cols)
 
 
 def _spmm(matrix: torch.Tensor, dense: torch.Tensor) -> torch.Tensor:

@@ -50,3 +50,23 @@ def test_repeated_copies_equal_the_offset_edge_list() -> None:
     layouts = repeated.block_layouts(4)
     assert layouts is not None and layouts[0][0] is blocks[0][0].layout(4)
     assert expected.block_layouts(4) is None
+
+
+@pytest.mark.parametrize("heads", [1, 4])
+def test_assembled_layout_and_transposes_equal_the_built_ones(heads: int) -> None:
+    # A repeated graph assembles its layout and its patterns' transposes from its
+    # blocks' (no sort); they must be the very index arrays a plain build gives.
+    first, second = random_graph(seed=1), random_graph(seed=2, num_nodes=30, connected=20,
+                                                          edges=80)
+    repeated = AttentionGraph.repeated([(AttentionGraph.from_edge_index(first, 60), 3),
+                                        (AttentionGraph.from_edge_index(second, 30), 2)])
+    plain = AttentionGraph.from_edge_index(repeated.edge_index, repeated.num_nodes)
+    assembled, built = repeated.layout(heads), plain.layout(heads)
+    for name in ("source_slot", "target_slot", "segment_index", "segment_ptr"):
+        assert torch.equal(getattr(assembled, name), getattr(built, name)), name
+    for name in ("head_rows", "node_rows"):
+        a, b = getattr(assembled, name), getattr(built, name)
+        assert a.blocks is not None and b.blocks is None
+        assert torch.equal(a.crow, b.crow) and torch.equal(a.col, b.col) and a.shape == b.shape
+        for x, y in zip(a.transpose_structure(), b.transpose_structure(), strict=True):
+            assert torch.equal(x, y), name
