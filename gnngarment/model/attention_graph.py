@@ -74,19 +74,18 @@ class AttentionGraph:
         """The disjoint union of ``copies`` copies of each graph, in order (nodes and
         edges numbered copy by copy): the same graph :meth:`from_edge_index` builds from
         the offset, concatenated edge lists, knowing its ``blocks``."""
-        ptrs = [torch.zeros(1, dtype=torch.long)]
-        sources = []
-        nodes = edges = 0
-        for graph, copies in blocks:
-            copy = torch.arange(copies)[:, None]
-            ptrs.append((graph.ptr[None, 1:].cpu() + edges + copy * graph.num_edges).flatten())
-            sources.append((graph.source[None].cpu() + nodes + copy * graph.num_nodes).flatten())
-            nodes += copies * graph.num_nodes
-            edges += copies * graph.num_edges
         device = blocks[0][0].device if blocks else torch.device("cpu")
         with structure_mode():
-            source = torch.cat(sources) if sources else torch.zeros(0, dtype=torch.long)
-            return cls(torch.cat(ptrs).to(device), source.to(device), nodes,
+            ptrs = [torch.zeros(1, dtype=torch.long, device=device)]
+            sources = [torch.zeros(0, dtype=torch.long, device=device)]
+            nodes = edges = 0
+            for graph, copies in blocks:
+                copy = torch.arange(copies, device=device)[:, None]
+                ptrs.append((graph.ptr[None, 1:] + edges + copy * graph.num_edges).flatten())
+                sources.append((graph.source[None] + nodes + copy * graph.num_nodes).flatten())
+                nodes += copies * graph.num_nodes
+                edges += copies * graph.num_edges
+            return cls(torch.cat(ptrs), torch.cat(sources), nodes,
                        tuple((graph, copies) for graph, copies in blocks))
 
     def block_layouts(self, heads: int) -> list[tuple[HeadLayout, int]] | None:

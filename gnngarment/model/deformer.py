@@ -20,11 +20,10 @@ from gnngarment.body.skinning import skin
 from gnngarment.data.pair import GarmentBodyPair
 from gnngarment.data.vertex_features import VERTEX_FEATURE_CHANNELS
 from gnngarment.geometry.hierarchy import PoolHierarchy
-from gnngarment.model.attention_graph import AttentionGraph
 from gnngarment.model.body_shape_encoder import BodyShapeEncoder
 from gnngarment.model.config import ModelConfig
 from gnngarment.model.garment_encoder import GarmentGraphEncoder
-from gnngarment.model.graph_levels import GraphLevels, level_graph, stack_hierarchies
+from gnngarment.model.graph_levels import GraphLevels, repeated_level_graph, stack_hierarchies
 from gnngarment.model.motion_encoder import MotionEncoder
 from gnngarment.model.multilevel_processor import MultilevelProcessor
 from gnngarment.model.skinning_weight_head import SkinningWeightHead, body_prior_logits
@@ -171,8 +170,7 @@ class GarmentDeformer(nn.Module):
         style = self.style_encoder(torch.stack([pair.descriptor for pair in pairs]))
         # The garments' own structures, kept between calls (a training run sees the same
         # garments batch after batch; see graph_levels.level_graph).
-        structure = (AttentionGraph.repeated([(level_graph(pair.hierarchy, 0, device), 1)
-                                              for pair in pairs])
+        structure = (repeated_level_graph([(pair.hierarchy, 1) for pair in pairs], 0, device)
                      if self.config.attention == "csr" else None)
         garment = self.garment_encoder(features, edge_index, style[pair_of_vertex], structure)
         body = self.body_encoder(torch.stack([pair.body_distances for pair in pairs]))

@@ -59,10 +59,8 @@ class GraphLevels:
         cached = self._attention.get(level)
         if cached is None or cached[0] is not edge_index:
             num_nodes = int(self.batch[level].shape[0])
-            if self.runs and any(copies > 1 for _, copies in self.runs):
-                graph = AttentionGraph.repeated([
-                    (level_graph(hierarchy, level, edge_index.device), copies)
-                    for hierarchy, copies in self.runs])
+            if self.runs:
+                graph = repeated_level_graph(self.runs, level, edge_index.device)
                 edges = sum(copies * _level_edges(hierarchy, level).shape[1]
                             for hierarchy, copies in self.runs)
                 if graph.num_nodes != num_nodes or edges != edge_index.shape[1]:
@@ -112,6 +110,14 @@ def level_graph(hierarchy: PoolHierarchy, level: int, device: torch.device) -> A
         graphs[(level, str(device))] = AttentionGraph.from_edge_index(
             torch.as_tensor(_level_edges(hierarchy, level), device=device), nodes)
     return graphs[(level, str(device))]
+
+
+def repeated_level_graph(runs: Sequence[tuple[PoolHierarchy, int]], level: int,
+                         device: torch.device) -> AttentionGraph:
+    """The attention graph at ``level`` of ``copies`` copies of each hierarchy in turn,
+    assembled from the cached :func:`level_graph` of each (no sort)."""
+    return AttentionGraph.repeated([(level_graph(hierarchy, level, device), copies)
+                                    for hierarchy, copies in runs])
 
 
 def _level_edges(hierarchy: PoolHierarchy, level: int) -> np.ndarray:
