@@ -28,6 +28,9 @@ class DataConfig:
         seed: seeds every sampler of the build.
         garment_types: garment types to cycle through.
         garments: garment designs in total (train + held out).
+        extra_train_garments: further train designs, drawn after the canonical plan
+            from a generator of their own, so adding them keeps every design, body,
+            motion and split the config had (the same validation and test sequences).
         garment_vertices: [min, max] target vertex count of a garment.
         bodies: body shapes in total; named presets are used first, then samples.
         body_presets: Anny presets to use first.
@@ -63,6 +66,7 @@ class DataConfig:
     garment_types: list[str] = field(default_factory=lambda: [
         "skirt", "dress", "jumpsuit", "tshirt", "trousers", "top"])
     garments: int = 12
+    extra_train_garments: int = 0
     garment_vertices: list[int] = field(default_factory=lambda: [900, 1500])
     bodies: int = 4
     body_presets: list[str] = field(default_factory=list)
@@ -115,6 +119,9 @@ class DataConfig:
                     "collision_points", "levels", "landmarks", "drape_frames"):
             if getattr(self, key) < 1:
                 raise ValueError(f"key '{key}': must be >= 1, got {getattr(self, key)}")
+        if self.extra_train_garments < 0:
+            raise ValueError("key 'extra_train_garments': must be >= 0, got "
+                             f"{self.extra_train_garments}")
         if self.motion_variants > self.motions_per_pair:
             raise ValueError(f"key 'motion_variants': {self.motion_variants} variants need at "
                              f"least as many motions per pair, got {self.motions_per_pair}")

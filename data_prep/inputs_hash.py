@@ -22,7 +22,8 @@ BUILDER_VERSION = 1
 #: Config keys that only decide *which* garments, bodies and motions are planned: their
 #: effect on a sequence is all in its plan (hashed with it), so changing them (e.g. more
 #: motions per pair) keeps every sequence and drape already built.
-PLAN_KEYS = ("seed", "garment_types", "garments", "garment_vertices", "bodies",
+PLAN_KEYS = ("seed", "garment_types", "garments", "extra_train_garments",
+             "garment_vertices", "bodies",
              "body_presets", "motions", "motions_per_pair", "motion_variants", "fabrics",
              "splits")
 #: Config keys that decide nothing a worker computes.

@@ -96,6 +96,7 @@ def plan_dataset(config: DataConfig) -> list[SequencePlan]:
     motions = [MotionPlan(f"{name}{k:02d}", name, int(rng.integers(1 << 30)), motion_split[k])
                for k, name in enumerate(config.motions)]
     train_motions = [m for m in motions if m.split == "train"]
+    designs += _extra_train_designs(config)
 
     sequences = []
     for design in designs:
@@ -122,6 +123,22 @@ def plan_dataset(config: DataConfig) -> list[SequencePlan]:
             f"motion ({repeated} sequences planned twice); there are {len(train_motions)} "
             f"train motions, each in {config.motion_variants} variant(s)")
     return sequences
+
+
+def _extra_train_designs(config: DataConfig) -> list[DesignPlan]:
+    """The config's ``extra_train_garments`` designs, numbered after the canonical ones
+    and drawn from a generator of their own (seeded by the config seed), so the draws
+    of the canonical plan — designs, motion seeds, splits — stay as they were."""
+    rng = np.random.default_rng([config.seed, 1 << 20])  # not any canonical draw
+    low, high = config.garment_vertices
+    designs = []
+    for k in range(config.garments, config.garments + config.extra_train_garments):
+        garment_type = config.garment_types[k % len(config.garment_types)]
+        designs.append(DesignPlan(
+            name=f"{garment_type}{k:03d}", garment_type=garment_type,
+            seed=int(rng.integers(1 << 30)), vertices=int(rng.integers(low, high + 1)),
+            fabric=config.fabrics[k % len(config.fabrics)], split="train"))
+    return designs
 
 
 #: Variant tempo and joint-angle multipliers are drawn from these ranges (the amplitude

@@ -37,3 +37,26 @@ def test_more_motions_per_pair_keeps_every_built_sequence(tmp_path: Path) -> Non
     slower = replace(config, fps=config.fps / 2)
     assert not any(sequence_inputs_hash(content_inputs(slower, settings), p) == before[p.name]
                    for p in plan_dataset(slower))
+
+
+def test_extra_train_garments_keep_every_planned_sequence(tmp_path: Path) -> None:
+    """More train designs (``extra_train_garments``) leave every sequence the config had
+    — its validation and test sequences included — with the same plan and inputs hash,
+    and add train sequences only, on designs of their own."""
+    from data_prep.simulate import load_simulation_settings
+
+    config = tiny_config(tmp_path)
+    grown = replace(config, extra_train_garments=config.garments + 1)
+    settings = load_simulation_settings(config.simulation)
+    before = plan_dataset(config)
+    after = plan_dataset(grown)
+    assert after[:len(before)] == before
+    hashes = [sequence_inputs_hash(content_inputs(grown, settings), p) for p in before]
+    assert hashes == [sequence_inputs_hash(content_inputs(config, settings), p) for p in before]
+    added = after[len(before):]
+    assert added and {p.split for p in added} == {"train"}
+    old_designs = {p.design.name for p in before}
+    assert not {p.design.name for p in added} & old_designs
+    assert len({p.design.seed for p in added}) == grown.extra_train_garments
+    with pytest.raises(ValueError, match="extra_train_garments"):
+        replace(config, extra_train_garments=-1)
