@@ -90,7 +90,8 @@ COMPONENTS = ("pose_encoder", "velocity_encoder", "supervised_processor", "physi
 def make_pair(pos: np.ndarray, faces: np.ndarray, config: ModelConfig,
               seed: int = 0) -> GarmentBodyPair:
     """A garment–body pair as ``tests/model/pairs.make_pair`` builds it (synthetic joints,
-    body distances and body skinning weights: only shapes matter for speed)."""
+    body distances, body skinning weights and joint distances: only shapes matter for
+    speed)."""
     rng = np.random.default_rng(seed)
     joints = rng.normal(scale=0.3, size=(24, 3))
     prepared = prepare_garment(pos, faces, GarmentPreparationConfig(
@@ -98,7 +99,7 @@ def make_pair(pos: np.ndarray, faces: np.ndarray, config: ModelConfig,
     return GarmentBodyPair.from_arrays(
         pos, garment_vertex_features(pos, faces, joints), prepared.hierarchy,
         prepared.descriptor, rng.random((config.body_vertices, 24)),
-        rng.dirichlet(np.ones(24), size=len(pos)))
+        rng.dirichlet(np.ones(24), size=len(pos)), rng.uniform(0.0, 0.4, (len(pos), 24)))
 
 
 def frame_inputs(config: ModelConfig, frames: int, seed: int = 0

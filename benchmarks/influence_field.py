@@ -48,6 +48,7 @@ from gnngarment.attribution import (
     mass_profile,
     render_comparison,
 )
+from gnngarment.body.joint_reach import joint_region_distances
 from gnngarment.body.weight_transfer import transfer_body_weights
 from gnngarment.config import load_config
 from gnngarment.data.pair import GarmentBodyPair
@@ -89,6 +90,15 @@ class Body:
         logits = -(distance - distance.min(axis=1, keepdims=True)) / 0.05
         weights = np.exp(logits)
         return (weights / weights.sum(axis=1, keepdims=True)).astype(np.float32)
+
+    def joint_distances(self, pos: np.ndarray) -> np.ndarray:
+        """``(N, 24)`` how far each joint's body region lies beyond the body (the weight
+        reach): measured on a real body; on the synthetic skeleton, each joint's
+        distance beyond the nearest joint."""
+        if self.rest_vertices is not None and self.skinning_weights is not None:
+            return joint_region_distances(pos, self.rest_vertices, self.skinning_weights)
+        distance = np.linalg.norm(pos[:, None] - self.joints[None], axis=-1)
+        return distance - distance.min(axis=1, keepdims=True)
 
 
 def garments(skirt_vertices: int, tube_shape: tuple[int, int], waist: np.ndarray
@@ -175,7 +185,8 @@ def make_pair(pos: np.ndarray, faces: np.ndarray, body: Body, config: ModelConfi
         levels=hierarchy_levels, landmarks=config.landmarks))
     return GarmentBodyPair.from_arrays(
         pos, garment_vertex_features(pos, faces, body.joints), prepared.hierarchy,
-        prepared.descriptor, body.distances, body.garment_weights(pos))
+        prepared.descriptor, body.distances, body.garment_weights(pos),
+        body.joint_distances(pos))
 
 
 def build_models(arguments: argparse.Namespace) -> dict[str, GarmentDeformer]:

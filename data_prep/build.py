@@ -37,6 +37,7 @@ from data_prep.build_records import (
 )
 from data_prep.config import DataConfig
 from data_prep.drape_worker import drape_and_prepare_garment
+from data_prep.garment_completion import complete_garment
 from data_prep.inputs_hash import (
     BUILDER_VERSION,
     content_inputs,
@@ -97,9 +98,11 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
     for plan in plans:
         garments.setdefault(plan.garment, (plan.design, plan.body))
     drape_tasks, garment_info, failed_garments = [], {}, {}
+    completed = 0
     for name, (design, body) in garments.items():
         garment_hash = garment_inputs_hash(base_hash, design, body)
         if garment_done(root, name, garment_hash):
+            completed += complete_garment(root, name, body)
             garment_info[name] = garment_summary(root, name)
             continue
         reason = known_failure(root, name, garment_hash, folder="garments")
@@ -109,6 +112,8 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
         drape_tasks.append((str(root), design, body, config, garment_hash))
 
     workers = workers or config.workers or None
+    if completed:
+        log(f"{completed} garments draped by an older builder completed (joint distances)")
     log(f"{len(garments)} garments planned: {len(garment_info)} already draped, "
         f"{len(failed_garments)} failed before with the same inputs, {len(drape_tasks)} to "
         "drape on their rest bodies")

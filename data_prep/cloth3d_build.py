@@ -156,6 +156,7 @@ def build_from_cloth3d(root: str | Path, smpl_model: str | Path | None, output: 
 
     from data_prep.cloth3d import Cloth3DError, read_info, read_sequence, scan_dataset
     from gnngarment.body.cloth3d_motion import load_cloth3d_motion
+    from gnngarment.body.joint_reach import joint_region_distances
     from gnngarment.body.smpl_model import SMPL_DOWNLOAD_HINT, SMPLBodyModel
     from gnngarment.body.weight_transfer import transfer_body_weights
     from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs
@@ -255,12 +256,13 @@ def build_from_cloth3d(root: str | Path, smpl_model: str | Path | None, output: 
             topology = topology_key(garment.faces)
             if not (output / "topologies" / f"{topology}.npz").is_file():
                 write_topology(output, topology, prepared.hierarchy)
-            weights = transfer_body_weights(rest, body.rest_vertices,
-                                            body_model.skinning_weights())
+            skinning = body_model.skinning_weights()
             write_garment(output, GarmentRecord(
                 name=name, rest_pos=rest, faces=garment.faces,
                 descriptor=prepared.descriptor, topology=topology,
-                garment_type=garment_name.lower(), body=body_name, body_weights=weights))
+                garment_type=garment_name.lower(), body=body_name,
+                body_weights=transfer_body_weights(rest, body.rest_vertices, skinning),
+                joint_distances=joint_region_distances(rest, body.rest_vertices, skinning)))
             write_sequence(output, SequenceRecord(
                 name=name, garment=name, body=body_name, motion=path.name, fps=fps,
                 positions=positions, joint_transforms=frames.joint_transforms,

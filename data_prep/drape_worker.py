@@ -35,6 +35,7 @@ def drape_and_prepare_garment(task: tuple[str, DesignPlan, BodyPlan, DataConfig,
     started = time.perf_counter()
     try:
         from data_prep.simulate import SimulationFailed, drape_garment, load_simulation_settings
+        from gnngarment.body.joint_reach import joint_region_distances
         from gnngarment.body.weight_transfer import transfer_body_weights
         from gnngarment.data.cache import (
             GarmentRecord,
@@ -68,12 +69,15 @@ def drape_and_prepare_garment(task: tuple[str, DesignPlan, BodyPlan, DataConfig,
         key = topology_key(made.faces)
         if not (root / "topologies" / f"{key}.npz").is_file():
             write_topology(root, key, prepared.hierarchy)
-        weights = transfer_body_weights(pos, body_vertices, body_model.skinning_weights())
+        skinning = body_model.skinning_weights()
+        weights = transfer_body_weights(pos, body_vertices, skinning)
         write_pins(root, name, made)
-        write_garment(root, GarmentRecord(name=name, rest_pos=pos, faces=made.faces,
-                                          descriptor=prepared.descriptor, topology=key,
-                                          garment_type=design.garment_type, body=body.name,
-                                          body_weights=weights, design_pos=made.pos))
+        write_garment(root, GarmentRecord(
+            name=name, rest_pos=pos, faces=made.faces, descriptor=prepared.descriptor,
+            topology=key, garment_type=design.garment_type, body=body.name,
+            body_weights=weights,
+            joint_distances=joint_region_distances(pos, body_vertices, skinning),
+            design_pos=made.pos))
         atomic_write_bytes(root / "garments" / f"{name}.hash", inputs_hash.encode())
         return {"name": name, "ok": True, "vertices": len(pos), "faces": len(made.faces),
                 "pinned": len(made.pinned), "drape_frames": drape.frames,

@@ -64,7 +64,10 @@ def build_synthetic_cache(root: Path, frames: int = 8, landmarks: int = 16,
                 write_garment(root, GarmentRecord(
                     name=name, rest_pos=pos.astype(np.float32), faces=faces,
                     descriptor=prepared.descriptor, topology=key, garment_type=garment_type,
-                    body=body, body_weights=np.eye(24, dtype=np.float32)[np.zeros(len(pos), int)]))
+                    body=body, body_weights=np.eye(24, dtype=np.float32)[np.zeros(len(pos), int)],
+                    # Joint 0's region is the garment itself; every other joint is 1 m away.
+                    joint_distances=np.where(np.arange(24) == 0, 0.0,
+                                             1.0)[None].repeat(len(pos), 0)))
                 for m, speed in enumerate((0.1, 0.25)):
                     angle = speed * np.arange(frames)
                     transforms = np.repeat(_rotation_z(angle)[:, None], 24, axis=1)

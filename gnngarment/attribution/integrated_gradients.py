@@ -202,4 +202,6 @@ def _pair_copy(pair: GarmentBodyPair, device: torch.device) -> GarmentBodyPair:
 
     return replace(pair, rest_pos=copy(pair.rest_pos), features=copy(pair.features),
                    descriptor=copy(pair.descriptor), body_distances=copy(pair.body_distances),
-                   body_weights=None if pair.body_weights is None else copy(pair.body_weights))
+                   body_weights=None if pair.body_weights is None else copy(pair.body_weights),
+                   joint_distances=(None if pair.joint_distances is None
+                                    else copy(pair.joint_distances)))

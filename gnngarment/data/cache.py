@@ -26,7 +26,8 @@ from gnngarment.io.atomic import atomic_write_bytes
 from gnngarment.io.npz import load_npz, save_npz_atomic
 
 #: Bumped when the layout of any cache file changes: older caches are rebuilt.
-CACHE_FORMAT_VERSION = 2
+#: 3: garments carry ``joint_distances`` (the weight reach is measured on the body).
+CACHE_FORMAT_VERSION = 3
 
 GARMENT_ARRAYS = ("rest_pos", "faces", "descriptor", "topology", "garment_type", "body")
 BODY_ARRAYS = ("joints", "distances", "subset")
@@ -59,8 +60,11 @@ class GarmentRecord:
     garment as worn (draped) on the rest body of ``body`` in the rest pose, where every
     sequence starts; faces ``(F, 3)``, descriptor ``(N*,)``; optional body_weights
     ``(N, 24)``, the body's skinning weights transferred from the nearest body vertices
-    (the body-skinning baseline and prior); optional design_pos ``(N, 3)``, the undraped
-    design the template was draped from (provenance only: no reader learns from it)."""
+    (the body-skinning baseline and prior); optional joint_distances ``(N, 24)`` metres,
+    how far each joint's body region lies beyond the nearest body point
+    (:func:`~gnngarment.body.joint_reach.joint_region_distances`: the weight reach);
+    optional design_pos ``(N, 3)``, the undraped design the template was draped from
+    (provenance only: no reader learns from it)."""
 
     name: str
     rest_pos: np.ndarray
@@ -70,6 +74,7 @@ class GarmentRecord:
     garment_type: str
     body: str
     body_weights: np.ndarray | None = None
+    joint_distances: np.ndarray | None = None
     design_pos: np.ndarray | None = None
 
 
@@ -125,6 +130,8 @@ def write_garment(root: Path, record: GarmentRecord) -> Path:
         "descriptor": record.descriptor.astype(np.float64),
         **({} if record.body_weights is None
            else {"body_weights": record.body_weights.astype(np.float32)}),
+        **({} if record.joint_distances is None
+           else {"joint_distances": record.joint_distances.astype(np.float32)}),
         **({} if record.design_pos is None
            else {"design_pos": record.design_pos.astype(np.float32)}),
         **_strings(record, ("topology", "garment_type", "body"))})
@@ -160,6 +167,7 @@ def read_garment(root: Path, name: str) -> GarmentRecord:
                          descriptor=data["descriptor"], topology=str(data["topology"]),
                          garment_type=str(data["garment_type"]), body=str(data["body"]),
                          body_weights=data.get("body_weights"),
+                         joint_distances=data.get("joint_distances"),
                          design_pos=data.get("design_pos"))
 
 

@@ -155,17 +155,19 @@ class PreparedDataset:
         edge_index = hierarchy.edge_index
         edges = torch.from_numpy(edge_index[:, edge_index[0] < edge_index[1]].astype(np.int64))
         rest_inverse, rest_area = rest_triangle_frames(record.rest_pos, record.faces)
-        # Both cache builders store the transferred body weights; a cache without them
-        # cannot recompute them (it keeps no body mesh): the pair then has none, and a
-        # model with the ``body`` weight prior rejects it by name.
-        body_weights = record.body_weights
+        # Both cache builders store the transferred body weights and joint distances; a
+        # cache without them cannot recompute them (it keeps no body mesh): the pair then
+        # has none, and a model with the ``body`` weight prior (or a reach) rejects it by
+        # name.
         count = len(record.rest_pos)
-        if body_weights is not None and tuple(body_weights.shape) != (count, NUM_JOINTS):
-            raise CacheError(f"{self.root}/garments/{garment}.npz: body_weights has shape "
-                             f"{tuple(body_weights.shape)}, expected ({count}, {NUM_JOINTS})")
+        for name in ("body_weights", "joint_distances"):
+            values = getattr(record, name)
+            if values is not None and tuple(values.shape) != (count, NUM_JOINTS):
+                raise CacheError(f"{self.root}/garments/{garment}.npz: {name} has shape "
+                                 f"{tuple(values.shape)}, expected ({count}, {NUM_JOINTS})")
         pair = GarmentBodyPair.from_arrays(record.rest_pos, features, hierarchy,
                                            record.descriptor, body_record.distances,
-                                           body_weights)
+                                           record.body_weights, record.joint_distances)
         mass = vertex_masses(record.rest_pos, record.faces, self.fabric_density)
         return _GarmentData(pair=pair, faces=faces, edges=edges,
                             rest_inverse=torch.from_numpy(rest_inverse.astype(np.float32)),

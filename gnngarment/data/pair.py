@@ -23,6 +23,10 @@ class GarmentBodyPair:
         body_weights: ``(N, 24)`` the body's skinning weights transferred to the garment's
             rest vertices (rows sum to 1; ``transfer_body_weights``): the ``body`` weight
             prior's starting point. ``None`` where unknown (models with prior ``none``).
+        joint_distances: ``(N, 24)`` how far (metres) each joint's body region lies from
+            each rest vertex beyond the body's nearest point
+            (:func:`~gnngarment.body.joint_reach.joint_region_distances`): the weight
+            reach's mask. ``None`` where unknown (models without a ``weight_reach``).
     """
 
     rest_pos: torch.Tensor
@@ -31,11 +35,13 @@ class GarmentBodyPair:
     descriptor: torch.Tensor
     body_distances: torch.Tensor
     body_weights: torch.Tensor | None = None
+    joint_distances: torch.Tensor | None = None
 
     @classmethod
     def from_arrays(cls, rest_pos: np.ndarray, features: np.ndarray, hierarchy: PoolHierarchy,
                     descriptor: np.ndarray, body_distances: np.ndarray,
-                    body_weights: np.ndarray | None = None) -> GarmentBodyPair:
+                    body_weights: np.ndarray | None = None,
+                    joint_distances: np.ndarray | None = None) -> GarmentBodyPair:
         """The pair from numpy arrays (any float dtype; each becomes a float32 tensor),
         with the shapes of the attributes above: the one place the data layer, ``animate``
         and the benchmarks turn arrays into the model's input."""
@@ -44,4 +50,6 @@ class GarmentBodyPair:
 
         return cls(rest_pos=tensor(rest_pos), features=tensor(features), hierarchy=hierarchy,
                    descriptor=tensor(descriptor), body_distances=tensor(body_distances),
-                   body_weights=None if body_weights is None else tensor(body_weights))
+                   body_weights=None if body_weights is None else tensor(body_weights),
+                   joint_distances=(None if joint_distances is None
+                                    else tensor(joint_distances)))

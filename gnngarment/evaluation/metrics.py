@@ -123,9 +123,7 @@ def far_joint_weight(weights: np.ndarray, rest_pos: np.ndarray, body_rest_vertic
         ``{"max": ..., "mean": ...}``: the largest and the mean far weight over vertices
         and frames, as fractions of each vertex's unit weight (0 = none, 1 = all).
     """
-    from scipy.spatial import cKDTree
-
-    from gnngarment.body.joint_reach import REGION_WEIGHT
+    from gnngarment.body.joint_reach import joint_region_distances
 
     weights = np.asarray(weights)
     if weights.ndim == 2:
@@ -134,11 +132,6 @@ def far_joint_weight(weights: np.ndarray, rest_pos: np.ndarray, body_rest_vertic
     if weights.ndim != 3 or weights.shape[1:] != (len(rest_pos), joints):
         raise ValueError(f"weights must be (T, {len(rest_pos)}, {joints}) or "
                          f"({len(rest_pos)}, {joints}), got {weights.shape}")
-    distance = np.full((len(rest_pos), joints), np.inf)
-    for joint in range(joints):
-        region = body_rest_vertices[body_skinning_weights[:, joint] >= REGION_WEIGHT]
-        if len(region):
-            distance[:, joint] = cKDTree(region).query(rest_pos)[0]
-    nearest = cKDTree(body_rest_vertices).query(rest_pos)[0]           # (N,)
-    far = (weights * (distance - nearest[:, None] > radius)[None]).sum(-1)  # (T, N)
+    distance = joint_region_distances(rest_pos, body_rest_vertices, body_skinning_weights)
+    far = (weights * (distance > radius)[None]).sum(-1)                  # (T, N)
     return {"max": float(far.max()), "mean": float(far.mean())}

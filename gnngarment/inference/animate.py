@@ -74,7 +74,9 @@ def garment_pair(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,
     """The model input of a garment (rest positions on the body's rest frame) on a body.
 
     For a model with the ``body`` weight prior, the body's skinning weights are
-    transferred to the garment (:func:`transfer_body_weights`, as the cache builders do).
+    transferred to the garment (:func:`transfer_body_weights`, as the cache builders do),
+    and with a weight reach each joint's body-region distance is measured
+    (:func:`joint_region_distances`).
 
     Raises:
         MeshError: the garment mesh is unusable (names ``source``).
@@ -82,23 +84,27 @@ def garment_pair(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,
             weights.
     """
     config = model.config
-    body_weights = None
+    body_weights = joint_distances = None
     if config.weight_prior == "body":
         # Imported here: the evaluation package imports much of the library.
+        from gnngarment.body.joint_reach import joint_region_distances
         from gnngarment.body.weight_transfer import transfer_body_weights
 
         if body.skinning_weights is None:
             raise ValueError(f"{source}: the model's weight_prior 'body' needs the body's "
                              "skinning weights (BodyShapeInputs.skinning_weights is None; "
                              "the body model does not expose them)")
-        body_weights = transfer_body_weights(
-            np.asarray(pos, dtype=np.float64), body.rest_vertices, body.skinning_weights)
+        rest = np.asarray(pos, dtype=np.float64)
+        body_weights = transfer_body_weights(rest, body.rest_vertices, body.skinning_weights)
+        if config.weight_reach is not None:
+            joint_distances = joint_region_distances(rest, body.rest_vertices,
+                                                     body.skinning_weights)
     if prepared is None:
         prepared = prepare_garment(pos, faces, GarmentPreparationConfig(
             levels=config.levels, landmarks=config.landmarks), source=source)
     return GarmentBodyPair.from_arrays(
         pos, garment_vertex_features(pos, faces, body.joints), prepared.hierarchy,
-        prepared.descriptor, body.distances, body_weights)
+        prepared.descriptor, body.distances, body_weights, joint_distances)
 
 
 #: Garment vertices × frames per forward pass (16 frames of a 5,000-vertex garment).

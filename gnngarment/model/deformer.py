@@ -176,7 +176,7 @@ class GarmentDeformer(nn.Module):
         body = self.body_encoder(torch.stack([pair.body_distances for pair in pairs]))
         fused = garment * body[pair_of_vertex]
         # Checked above: every pair has body weights when the head has the prior.
-        prior_logits = (torch.cat([body_prior_logits(p.body_weights, p.rest_pos,
+        prior_logits = (torch.cat([body_prior_logits(p.body_weights, p.joint_distances,
                                                      self.config.weight_reach) for p in pairs])
                         if self.weight_head.body_prior else None)
         return DeformerContext(fused=fused, rest_pos=torch.cat([p.rest_pos for p in pairs]),
@@ -272,9 +272,10 @@ def check_pair_fits(pair: GarmentBodyPair, config: ModelConfig) -> None:
     """Raise ``ValueError`` (naming the array, and the setting where one decides its
     shape) when ``pair`` does not fit a model of ``config``: wrong shapes or non-finite
     values, a descriptor of another length than ``landmarks``, body features for
-    another ``body_vertices``, fewer pooling levels than the model pools, or no body
-    weights for the ``body`` prior. :meth:`GarmentDeformer.encode` checks every pair;
-    a trainer checks its cache's first one before any epoch."""
+    another ``body_vertices``, fewer pooling levels than the model pools, no body
+    weights for the ``body`` prior, or no joint distances for its ``weight_reach``.
+    :meth:`GarmentDeformer.encode` checks every pair; a trainer checks its cache's first
+    one before any epoch."""
     n = pair.rest_pos.shape[0]
     expected = {
         "rest_pos": (n, 3), "features": (n, VERTEX_FEATURE_CHANNELS),
@@ -290,7 +291,13 @@ def check_pair_fits(pair: GarmentBodyPair, config: ModelConfig) -> None:
         if not torch.isfinite(getattr(pair, name)).all():
             raise ValueError(f"{name} contains NaN or inf")
     if config.weight_prior == "body":
-        _check_body_weights(pair.body_weights, n)
+        _check_per_joint(pair.body_weights, "body_weights", n, "weight_prior 'body' needs "
+                         "the garment's transferred body skinning weights")
+        if config.weight_reach is not None:
+            _check_per_joint(pair.joint_distances, "joint_distances", n, "weight_reach "
+                             f"{config.weight_reach} needs how far each joint's body region "
+                             "lies from the garment (joint_region_distances)",
+                             infinite_allowed=True)   # +inf: a joint that moves no body vertex
     if pair.hierarchy.num_vertices != n:
         raise ValueError(f"hierarchy has {pair.hierarchy.num_vertices} vertices, "
                          f"garment has {n}")
@@ -299,15 +306,14 @@ def check_pair_fits(pair: GarmentBodyPair, config: ModelConfig) -> None:
                          f"model pools {config.levels} (levels)")
 
 
-def _check_body_weights(body_weights: torch.Tensor | None, n: int) -> None:
-    if body_weights is None:
-        raise ValueError("body_weights is missing; weight_prior 'body' needs "
-                         f"the garment's transferred body skinning weights ({n}, {NUM_JOINTS})")
-    if tuple(body_weights.shape) != (n, NUM_JOINTS):
-        raise ValueError(f"body_weights has shape {tuple(body_weights.shape)}, "
-                         f"expected {(n, NUM_JOINTS)}")
-    if not torch.isfinite(body_weights).all():
-        raise ValueError("body_weights contains NaN or inf")
+def _check_per_joint(values: torch.Tensor | None, name: str, n: int, needed_for: str,
+                     infinite_allowed: bool = False) -> None:
+    if values is None:
+        raise ValueError(f"{name} is missing; {needed_for} ({n}, {NUM_JOINTS})")
+    if tuple(values.shape) != (n, NUM_JOINTS):
+        raise ValueError(f"{name} has shape {tuple(values.shape)}, expected {(n, NUM_JOINTS)}")
+    if (torch.isnan(values) if infinite_allowed else ~torch.isfinite(values)).any():
+        raise ValueError(f"{name} contains NaN" + ("" if infinite_allowed else " or inf"))
 
 
 def _check_frames(motion: torch.Tensor, velocity: torch.Tensor, transforms: torch.Tensor,

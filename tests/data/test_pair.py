@@ -57,8 +57,9 @@ def test_from_arrays_gives_float32_tensors_of_the_same_values() -> None:
     built = GarmentBodyPair.from_arrays(
         pair.rest_pos.double().numpy(), pair.features.numpy(), pair.hierarchy,
         pair.descriptor.double().numpy(), pair.body_distances.numpy(),
-        pair.body_weights.double().numpy())
-    for name in ("rest_pos", "features", "descriptor", "body_distances", "body_weights"):
+        pair.body_weights.double().numpy(), pair.joint_distances.double().numpy())
+    for name in ("rest_pos", "features", "descriptor", "body_distances", "body_weights",
+                 "joint_distances"):
         value = getattr(built, name)
         assert value.dtype == torch.float32, name
         assert torch.equal(value, getattr(pair, name)), name
@@ -87,6 +88,7 @@ def test_cached_pairs_have_the_documented_shapes_and_contents(cache: Path) -> No
         assert pair.body_distances.shape == (BODY_VERTICES, 24)
         assert pair.body_weights.shape == (n, 24)
         np.testing.assert_allclose(pair.body_weights.sum(1).numpy(), 1.0, rtol=1e-6)
+        np.testing.assert_array_equal(pair.joint_distances.numpy(), record.joint_distances)
         check_pair_fits(pair, config())
 
 
@@ -123,8 +125,13 @@ def test_inference_builds_the_pair_the_cache_holds(cache: Path) -> None:
      "body_distances contains NaN or inf"),
     (lambda p: dict(body_weights=p.body_weights[:, :23]),
      r"body_weights has shape \(\d+, 23\), expected \(\d+, 24\)"),
+    (lambda p: dict(joint_distances=None), r"joint_distances is missing; weight_reach 0.2"),
+    (lambda p: dict(joint_distances=p.joint_distances[:-1]),
+     r"joint_distances has shape \(\d+, 24\), expected"),
+    (lambda p: dict(joint_distances=p.joint_distances.clone().fill_(float("nan"))),
+     r"joint_distances contains NaN$"),
     (lambda p: dict(rest_pos=p.rest_pos[:-1], features=p.features[:-1],
-                    body_weights=p.body_weights[:-1]),
+                    body_weights=p.body_weights[:-1], joint_distances=p.joint_distances[:-1]),
      r"hierarchy has (\d+) vertices, garment has"),
 ])
 def test_a_pair_of_mismatched_arrays_is_rejected_naming_the_array(change, message: str

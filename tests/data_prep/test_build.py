@@ -22,7 +22,7 @@ from data_prep.config import DataConfig
 from data_prep.plan import plan_dataset
 from gnngarment.config import load_config
 from gnngarment.data import PreparedDataset
-from gnngarment.data.cache import read_garment, read_sequence
+from gnngarment.data.cache import read_garment, read_sequence, write_garment
 from gnngarment.io.atomic import TEMP_SUFFIX
 from gnngarment.paths import REPOSITORY_ROOT
 
@@ -118,6 +118,18 @@ def test_build_killed_mid_way_resumes(tmp_path: Path) -> None:
     again = build_dataset(replace(config, workers=1), log=lambda _: None)
     assert again["simulated"] == 0  # built and failed sequences are both remembered
     assert again["manifest_hash"] == report["manifest_hash"]
+
+    # A garment written by an older builder (cache format 2: no joint distances) is
+    # completed on resume, to the numbers a fresh drape writes, and nothing is simulated.
+    name = next(iter(manifest["sequences"].values()))["garment"]
+    fresh = read_garment(tmp_path / "data", name)
+    write_garment(tmp_path / "data", replace(fresh, joint_distances=None))
+    lines: list[str] = []
+    upgraded = build_dataset(replace(config, workers=1), log=lines.append)
+    assert upgraded["simulated"] == 0
+    assert any("1 garments draped by an older builder completed" in line for line in lines)
+    np.testing.assert_allclose(read_garment(tmp_path / "data", name).joint_distances,
+                               fresh.joint_distances, atol=1e-6)
 
 
 @pytest.mark.parametrize(("override", "key"), [

@@ -32,6 +32,7 @@ def make_pair(pos: np.ndarray, faces: np.ndarray, config: ModelConfig, seed: int
         descriptor=torch.tensor(prepared.descriptor, dtype=torch.float32),
         body_distances=torch.tensor(rng.random((config.body_vertices, 24)), dtype=torch.float32),
         body_weights=nearest_joint_weights(pos, joints),
+        joint_distances=beyond_nearest_joint(pos, joints),
     )
 
 
@@ -42,6 +43,14 @@ def nearest_joint_weights(pos: np.ndarray, joints: np.ndarray, scale: float = 0.
     distance = torch.cdist(torch.as_tensor(pos, dtype=torch.float64),
                            torch.as_tensor(joints, dtype=torch.float64))
     return torch.softmax(-distance / scale, dim=-1).float()
+
+
+def beyond_nearest_joint(pos: np.ndarray, joints: np.ndarray) -> torch.Tensor:
+    """``(N, 24)`` stand-in joint distances (metres): each joint's distance beyond the
+    nearest joint (the body here is its joints)."""
+    distance = torch.cdist(torch.as_tensor(pos, dtype=torch.float64),
+                           torch.as_tensor(joints, dtype=torch.float64))
+    return (distance - distance.min(dim=1, keepdim=True).values).float()
 
 
 def frame_inputs(config: ModelConfig, pairs: int, frames: int, seed: int = 0,
