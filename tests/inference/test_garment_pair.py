@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import torch
 
+from gnngarment.body.joint_reach import joint_region_distances
 from gnngarment.body.weight_transfer import transfer_body_weights
 from gnngarment.data.body_inputs import BodyShapeInputs
 from gnngarment.inference.animate import garment_pair
@@ -34,14 +35,26 @@ def test_body_prior_pairs_carry_the_transferred_body_weights() -> None:
     pair = garment_pair(model, pos, faces, body)
     expected = transfer_body_weights(pos, body.rest_vertices, body.skinning_weights)
     np.testing.assert_allclose(pair.body_weights.numpy(), expected)
+    # The weight reach is measured on the chosen body, as the far-joint metric measures.
+    np.testing.assert_allclose(
+        pair.joint_distances.numpy(),
+        joint_region_distances(pos, body.rest_vertices, body.skinning_weights), rtol=1e-6)
     model.encode([pair])  # accepted as it is
     with pytest.raises(ValueError, match="skinning weights"):
         garment_pair(model, pos, faces, body_shape(model.config, skinning=False))
+
+
+def test_models_without_a_reach_need_no_joint_distances() -> None:
+    pos, faces = tube(6, 8)
+    model = GarmentDeformer(replace(tiny_config(), weight_reach=None))
+    pair = garment_pair(model, pos, faces, body_shape(model.config))
+    assert pair.body_weights is not None and pair.joint_distances is None
+    model.encode([pair])
 
 
 def test_models_without_the_prior_need_no_body_weights() -> None:
     pos, faces = tube(6, 8)
     model = GarmentDeformer(replace(tiny_config(), weight_prior="none"))
     pair = garment_pair(model, pos, faces, body_shape(model.config, skinning=False))
-    assert pair.body_weights is None
+    assert pair.body_weights is None and pair.joint_distances is None
     assert torch.isfinite(model.encode([pair]).fused).all()
