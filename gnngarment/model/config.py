@@ -55,8 +55,10 @@ class ModelConfig:
         weight_reach: with the ``body`` prior, the distance (metres) beyond which a
             joint may not move a garment vertex: joints whose body region (body vertices
             it moves by at least 0.1) lies farther than that beyond the vertex's nearest
-            body point (``GarmentBodyPair.joint_distances``) get no weight at all, so
-            the far-joint metric's bound at the same distance holds by construction.
+            body point (``GarmentBodyPair.joint_distances``), or whose garment region
+            (garment vertices its transferred weight moves by at least 0.1) lies
+            farther than that from the vertex, get no weight at all; the far-joint
+            metric's bound at the same distance holds by construction.
             ``None`` (what checkpoints saved before it existed load as) allows
             every joint. The paper's head (``weight_prior: none``) has no prior to
             limit and ignores it.

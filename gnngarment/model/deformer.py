@@ -176,8 +176,9 @@ class GarmentDeformer(nn.Module):
         body = self.body_encoder(torch.stack([pair.body_distances for pair in pairs]))
         fused = garment * body[pair_of_vertex]
         # Checked above: every pair has body weights when the head has the prior.
-        prior_logits = (torch.cat([body_prior_logits(p.body_weights, p.joint_distances,
-                                                     self.config.weight_reach) for p in pairs])
+        prior_logits = (torch.cat([body_prior_logits(p.body_weights, p.rest_pos,
+                                                     p.joint_distances, self.config.weight_reach)
+                                   for p in pairs])
                         if self.weight_head.body_prior else None)
         return DeformerContext(fused=fused, rest_pos=torch.cat([p.rest_pos for p in pairs]),
                                ptr=_offsets(sizes), hierarchies=[p.hierarchy for p in pairs],

@@ -13,25 +13,25 @@ from gnngarment.body.joint_reach import reachable_joints
 BODY_WEIGHT_FLOOR = 1e-6
 
 
-def body_prior_logits(body_weights: torch.Tensor, joint_distances: torch.Tensor | None = None,
+def body_prior_logits(body_weights: torch.Tensor, rest_pos: torch.Tensor | None = None,
+                      joint_distances: torch.Tensor | None = None,
                       reach: float | None = None) -> torch.Tensor:
     """``log(max(W_body, 1e-6))``: logits whose softmax is the body weights (up to the
-    floor's renormalisation). With ``reach`` (metres), joints whose body region lies
-    farther than that beyond a vertex's nearest body point
-    (:func:`~gnngarment.body.joint_reach.reachable_joints`) get ``-inf``: no correction
-    the head learns can give them weight, so a trouser leg never follows the neck
-    however the motion moves it.
+    floor's renormalisation). With ``reach`` (metres), joints out of reach of a vertex on
+    the body or on the garment (:func:`~gnngarment.body.joint_reach.reachable_joints`)
+    get ``-inf``: no correction the head learns can give them weight, so a trouser leg
+    never follows the neck however the motion moves it.
 
-    Shapes: body_weights ``(N, 24)``, joint_distances ``(N, 24)`` metres (needed with
-    ``reach``; ``GarmentBodyPair.joint_distances``) → ``(N, 24)``.
+    Shapes: body_weights ``(N, 24)``, rest_pos ``(N, 3)`` and joint_distances ``(N, 24)``
+    metres (both needed with ``reach``; ``GarmentBodyPair``) → ``(N, 24)``.
     """
     logits = torch.log(body_weights.clamp_min(BODY_WEIGHT_FLOOR))
     if reach is None:
         return logits
-    if joint_distances is None:
-        raise ValueError("a weight reach needs the garment's joint_distances")
-    return logits.masked_fill(~reachable_joints(joint_distances, body_weights, reach),
-                              -torch.inf)
+    if rest_pos is None or joint_distances is None:
+        raise ValueError("a weight reach needs the garment's rest_pos and joint_distances")
+    reachable = reachable_joints(rest_pos, body_weights, joint_distances, reach)
+    return logits.masked_fill(~reachable, -torch.inf)
 
 
 class SkinningWeightHead(nn.Module):

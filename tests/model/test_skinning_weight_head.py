@@ -59,7 +59,7 @@ def test_untrained_head_with_a_reach_is_body_skinning_on_the_reachable_joints(ga
     assert model.config.weight_reach == 0.2
     pair = make_pair(*garment, model.config)
     out = model(model.encode([pair]), *frame_inputs(model.config, 1, 2))
-    reachable = reachable_joints(pair.joint_distances, pair.body_weights, 0.2)
+    reachable = reachable_joints(pair.rest_pos, pair.body_weights, pair.joint_distances, 0.2)
     kept = floored(pair.body_weights) * reachable
     expected = (kept / kept.sum(-1, keepdim=True)).repeat(2, 1)
     torch.testing.assert_close(out.weights, expected, atol=1e-6, rtol=0)
@@ -185,7 +185,7 @@ def test_weight_reach_gives_far_joints_no_weight(garment) -> None:
     models = {reach: build(seed=4, weight_reach=reach) for reach in (None, 0.05)}
     pair = make_pair(*garment, models[None].config)
     inputs = frame_inputs(models[None].config, 1, 2)
-    reachable = reachable_joints(pair.joint_distances, pair.body_weights, 0.05)
+    reachable = reachable_joints(pair.rest_pos, pair.body_weights, pair.joint_distances, 0.05)
     assert 0 < reachable.sum() < reachable.numel()
     far = ~reachable.repeat(2, 1)
     for reach, model in models.items():
