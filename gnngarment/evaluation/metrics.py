@@ -109,8 +109,9 @@ def far_joint_weight(weights: np.ndarray, rest_pos: np.ndarray, body_rest_vertic
     noticeably (skinning weight ≥ ``REGION_WEIGHT``); its distance is that of the
     region's nearest vertex, counted from the vertex's nearest body vertex (so a hem
     hanging 25 cm off the legs is not "far" from the legs). A joint that moves no body
-    vertex counts as far. Such weight makes the vertex follow a distant limb (a hem
-    dragged along by a wrist).
+    vertex counts as far (:func:`~gnngarment.body.joint_reach.joint_region_distances`,
+    the distance the model's weight reach masks by). Such weight makes the vertex follow
+    a distant limb (a hem dragged along by a wrist).
     (Regions by *dominant* joint were tried first and are wrong: Anny's pelvis dominates
     no vertex, so a skirt skinned to the pelvis counted as 100 % far.)
 
