@@ -9,14 +9,14 @@ beyond the vertex's nearest body point (:func:`joint_region_distances`: so a hem
 reach by that same distance — so the metric's bound holds by construction — and also
 every joint whose **garment** region (garment vertices its transferred body weight moves
 by at least :data:`REGION_WEIGHT`) is out of reach: a joint that moves no part of the
-garment near a vertex has no business moving it (the hands for trousers, whose hips lie
-near the hanging hands on the body).
+garment near a vertex has no business moving it.
 
 Why both (measured, docs/results.md "The weight reach on the body's regions"): the
 garment's regions alone let a trained model put 93 % of a sleeve vertex's weight on the
 spine, whose garment region (the torso) lies within 20 cm of the armpit while its body
 region does not; the body's regions alone admit joints the shipped model was never
-trained on for some vertices (a skirt's hips, trousers' knees) and cost it 0.35 mm on the
+trained on for some vertices (on the demo test trousers: the pelvis, hips, knees and
+lower spine at vertices the garment rule forbade them) and cost it 0.35 mm on the
 benchmark test split (skirt 8.1 → 9.7 mm). Together they bound the far weight at 0 and
 leave the shipped model's test figures unchanged to every printed digit.
 """
