@@ -111,3 +111,6 @@ def test_pairs_carry_the_cached_body_weights(cache: Path, tmp_path: Path) -> Non
     rewrite(replace(record, body_weights=record.body_weights[:-1]))
     with pytest.raises(CacheError, match="body_weights has shape"):
         PreparedDataset(copy, "train", window=2).garment_of(name)
+    rewrite(replace(record, joint_distances=record.joint_distances[:, :23]))
+    with pytest.raises(CacheError, match=rf"{garment}\.npz: joint_distances has shape"):
+        PreparedDataset(copy, "train", window=2).garment_of(name)
