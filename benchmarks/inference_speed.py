@@ -2,8 +2,11 @@
 
 For ``configs/model/small.yaml`` and ``configs/model/paper.yaml`` on a ~5k-vertex flared
 skirt (one garment–body pair, context prepared once), prints frames/s of the full
-per-frame model (both LSTMs, both M^mp submodules, skinning; ``use_physics=True`` as
-deployed) at each batch size under ``torch.inference_mode``, for both GAT
+per-frame model (both LSTMs, M^mp, skinning) at each batch size under
+``torch.inference_mode`` — with ``--physics checkpoint`` as ``gnngarment animate`` runs the
+model (the shipped supervised-stage checkpoint uses only the supervised M^mp), with
+``--physics on`` with both M^mp submodules (a model trained through the physics stage);
+both by default, each with its own ratio line — for both GAT
 implementations (``csr``: GraphAttention, ``pyg``: GATConv), with:
 
 * the peak resident memory of the measuring process (each config × implementation runs
@@ -461,7 +464,12 @@ def child(args: argparse.Namespace) -> None:
     pos, faces = flared_skirt(args.vertices)
     pair = make_pair(pos, faces, config)
     base, weights = initial_model(config, args)
-    base.use_physics = True
+    if args.physics[0] == "on":
+        base.use_physics = True
+    # Else the model's own setting, what `gnngarment animate` runs: a checkpoint records
+    # whether its physics submodule is trained and used (the shipped one, a supervised-
+    # stage checkpoint, does not use it); freshly initialised weights do not use it.
+    physics = "both M^mp" if base.use_physics else "supervised M^mp only"
     timer = ComponentTimer()
     models, contexts, results = {}, {}, {}
     with torch.inference_mode():
@@ -471,6 +479,7 @@ def child(args: argparse.Namespace) -> None:
             tic = time.perf_counter()
             contexts[impl] = models[impl].encode([pair])
             results[impl] = {"config": args.config, "attention": impl, "vertices": len(pos),
+                             "physics": physics,
                              "threads": threads, "weights": weights,
                              "prepare_s": time.perf_counter() - tic,
                              "rss_after_prepare_mb": peak_rss_mb(), "batches": {}}
@@ -603,13 +612,15 @@ def measure_simulator(pos: np.ndarray, faces: np.ndarray, frames: int) -> float 
 
 def label(r: dict) -> str:
     attention = r["attention"] + (f" (child: {r['child']})" if "child" in r else "")
-    return f"{r['config']} | {attention} | {r.get('malloc', 'default')} | {r['threads']}"
+    return (f"{r['config']} ({r['physics']}) | {attention} | {r.get('malloc', 'default')} "
+            f"| {r['threads']}")
 
 
 def report(results: list[dict]) -> dict[str, float]:
-    """Print the tables; return each config's best float32 frames/s at the largest batch."""
+    """Print the tables; return each config's (and physics setting's) best float32
+    frames/s at the largest batch."""
     best: dict[str, float] = {}
-    print("\n## frames/s (best of repeats; float32, inference_mode, both M^mp submodules)")
+    print("\n## frames/s (best of repeats; float32, inference_mode)")
     print("| config | attention | malloc | threads | batch | ms/batch | frames/s "
           "| median frames/s | peak RSS MB |")
     print("|---|---|---|---|---|---|---|---|---|")
@@ -618,7 +629,8 @@ def report(results: list[dict]) -> dict[str, float]:
         for frames, e in r["batches"].items():
             fps = int(frames) / e["best_s"]
             if int(frames) == largest:
-                best[r["config"]] = max(best.get(r["config"], 0.0), fps)
+                key = f"{r['config']} ({r['physics']})"
+                best[key] = max(best.get(key, 0.0), fps)
             print(f"| {label(r)} | {frames} | {1000 * e['best_s']:.0f} | {fps:.1f} "
                   f"| {int(frames) / e['median_s']:.1f} | {e['peak_rss_mb']:.0f} |")
     for r in results:
@@ -748,6 +760,12 @@ def main() -> None:
                         help="cold: each compiled child starts with an empty inductor "
                              "cache (the first call is the full compile); warm: the "
                              "default cache, as a second run on the same machine")
+    parser.add_argument("--physics", nargs="+", choices=["checkpoint", "on"],
+                        default=["checkpoint", "on"],
+                        help="checkpoint: the model's own use_physics, as `gnngarment "
+                             "animate` runs it (the shipped supervised-stage checkpoint: "
+                             "the supervised M^mp only); on: both M^mp submodules, as a "
+                             "model trained through the physics stage runs")
     parser.add_argument("--onnx", action="store_true",
                         help="try exporting M^mp to ONNX; time onnxruntime's MatMul, alone "
                              "and inside M^mp (needs onnxruntime and onnx)")
@@ -777,7 +795,8 @@ def main() -> None:
     if args.onnx:
         extras.append(("onnx", ["--onnx"]))
     jobs = []
-    for threads, config in ((t, c) for t in args.threads for c in args.configs):
+    for threads, config, physics in ((t, c, p) for t in args.threads for c in args.configs
+                                     for p in dict.fromkeys(args.physics)):
         for malloc in variants:
             # All implementations in one child, interleaved; the tuned-malloc child only
             # repeats the csr runs (the environment must be set when the process starts).
@@ -786,14 +805,14 @@ def main() -> None:
             redundant = (extras and impls == ["csr"] and not args.bf16
                          and args.profile_batch not in args.batches)
             if not redundant:
-                jobs.append((threads, config, malloc, impls, None, []))
+                jobs.append((threads, config, physics, malloc, impls, None, []))
             if malloc == variants[0]:
-                jobs += [(threads, config, malloc, ["csr"], name, extra)
+                jobs += [(threads, config, physics, malloc, ["csr"], name, extra)
                          for name, extra in extras]
-    for threads, config, malloc, impls, extra_name, extra in jobs:
+    for threads, config, physics, malloc, impls, extra_name, extra in jobs:
         main_child = extra_name is None
         command = [sys.executable, __file__, "--child", "--config", config,
-                   "--checkpoint", args.checkpoint,
+                   "--checkpoint", args.checkpoint, "--physics", physics,
                    "--impl", *impls, "--vertices", str(args.vertices),
                    "--repeats", str(args.repeats), "--threads", str(threads),
                    "--profile-batch",
@@ -817,7 +836,8 @@ def main() -> None:
         if cache is not None:
             cache.cleanup()
         lines = [ln for ln in done.stdout.splitlines() if ln.startswith("RESULT ")]
-        what = f"{config}/{malloc}/{threads} threads" + (f" ({extra_name})" if extra else "")
+        what = (f"{config}/{physics}/{malloc}/{threads} threads"
+                + (f" ({extra_name})" if extra else ""))
         if done.returncode != 0 or not lines:
             print(f"{what} failed:\n{done.stderr[-3000:]}")
             continue
@@ -827,7 +847,8 @@ def main() -> None:
             if extra_name is not None:
                 result["child"] = extra_name
             results.append(result)
-        print(f"measured {config} ({', '.join(impls)}), malloc {malloc}, {threads} threads"
+        print(f"measured {config} ({', '.join(impls)}), physics {physics}, malloc {malloc}, "
+              f"{threads} threads"
               f"{f', {extra_name}' if extra_name else ''}, in {time.perf_counter() - tic:.0f} s",
               flush=True)
     best = report(results)
