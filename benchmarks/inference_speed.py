@@ -610,10 +610,14 @@ def measure_simulator(pos: np.ndarray, faces: np.ndarray, frames: int) -> float 
     return 1 / result.seconds_per_frame
 
 
+def variant(r: dict) -> str:
+    """The network timed: config and which M^mp submodules ran."""
+    return f"{r['config']} ({r['physics']})"
+
+
 def label(r: dict) -> str:
     attention = r["attention"] + (f" (child: {r['child']})" if "child" in r else "")
-    return (f"{r['config']} ({r['physics']}) | {attention} | {r.get('malloc', 'default')} "
-            f"| {r['threads']}")
+    return f"{variant(r)} | {attention} | {r.get('malloc', 'default')} | {r['threads']}"
 
 
 def report(results: list[dict]) -> dict[str, float]:
@@ -629,8 +633,7 @@ def report(results: list[dict]) -> dict[str, float]:
         for frames, e in r["batches"].items():
             fps = int(frames) / e["best_s"]
             if int(frames) == largest:
-                key = f"{r['config']} ({r['physics']})"
-                best[key] = max(best.get(key, 0.0), fps)
+                best[variant(r)] = max(best.get(variant(r), 0.0), fps)
             print(f"| {label(r)} | {frames} | {1000 * e['best_s']:.0f} | {fps:.1f} "
                   f"| {int(frames) / e['median_s']:.1f} | {e['peak_rss_mb']:.0f} |")
     for r in results:

@@ -3,6 +3,9 @@ body-skinning prior."""
 
 from __future__ import annotations
 
+import weakref
+from collections import OrderedDict
+
 import torch
 from torch import nn
 
@@ -11,6 +14,31 @@ from gnngarment.body.joint_reach import reachable_joints
 #: Smallest body weight the prior's logarithm sees: joints the body gives no weight
 #: start at ``log(1e-6) ≈ −13.8``, far below, but still reachable by training.
 BODY_WEIGHT_FLOOR = 1e-6
+
+#: Reach masks kept between calls, least recently used first out. The mask is a constant
+#: of a garment–body pair, but `GarmentDeformer.encode` runs on every training step, and
+#: recomputing it cost 5–10 ms per ~900-vertex pair (a few % of a step). A training run
+#: sees a few hundred pairs; a mask is ``N × 24`` bools (24 KB at 1,000 vertices).
+CACHED_REACH_MASKS = 512
+_reach_masks: OrderedDict[tuple[int, int, int, float],
+                          tuple[tuple[weakref.ref, ...], torch.Tensor]] = OrderedDict()
+
+
+def _reachable(rest_pos: torch.Tensor, body_weights: torch.Tensor,
+               joint_distances: torch.Tensor, reach: float) -> torch.Tensor:
+    """:func:`reachable_joints`, computed once for the same three tensor objects while
+    they live (they are a pair's constants: nothing writes them in place)."""
+    tensors = (rest_pos, body_weights, joint_distances)
+    key = (*(id(t) for t in tensors), reach)
+    entry = _reach_masks.get(key)
+    if entry is None or any(ref() is not t for ref, t in zip(entry[0], tensors, strict=True)):
+        entry = (tuple(weakref.ref(t) for t in tensors),
+                 reachable_joints(rest_pos, body_weights, joint_distances, reach))
+        _reach_masks[key] = entry
+        while len(_reach_masks) > CACHED_REACH_MASKS:
+            _reach_masks.popitem(last=False)
+    _reach_masks.move_to_end(key)
+    return entry[1]
 
 
 def body_prior_logits(body_weights: torch.Tensor, rest_pos: torch.Tensor | None = None,
@@ -30,7 +58,7 @@ def body_prior_logits(body_weights: torch.Tensor, rest_pos: torch.Tensor | None 
         return logits
     if rest_pos is None or joint_distances is None:
         raise ValueError("a weight reach needs the garment's rest_pos and joint_distances")
-    reachable = reachable_joints(rest_pos, body_weights, joint_distances, reach)
+    reachable = _reachable(rest_pos, body_weights, joint_distances, reach)
     return logits.masked_fill(~reachable, -torch.inf)
 
 

@@ -65,6 +65,31 @@ def test_untrained_head_with_a_reach_is_body_skinning_on_the_reachable_joints(ga
     torch.testing.assert_close(out.weights, expected, atol=1e-6, rtol=0)
 
 
+def test_reach_mask_is_computed_once_per_pair(garment, monkeypatch) -> None:
+    # encode runs on every training step; the mask is a constant of the pair's tensors.
+    from gnngarment.model import skinning_weight_head
+
+    calls = []
+    original = skinning_weight_head.reachable_joints
+    monkeypatch.setattr(skinning_weight_head, "reachable_joints",
+                        lambda *args: calls.append(1) or original(*args))
+    model = build()
+    pair = make_pair(*garment, model.config)
+    first = body_prior_logits(pair.body_weights, pair.rest_pos, pair.joint_distances, 0.2)
+    again = body_prior_logits(pair.body_weights, pair.rest_pos, pair.joint_distances, 0.2)
+    assert len(calls) == 1 and torch.equal(first, again)
+    # Other tensors (here: the garment scaled 3×, so its garment regions are farther
+    # apart) or another reach are computed afresh, never served a stale mask.
+    scaled = pair.rest_pos * 3.0
+    shifted = body_prior_logits(pair.body_weights, scaled, pair.joint_distances, 0.2)
+    assert len(calls) == 2
+    expected = original(scaled, pair.body_weights, pair.joint_distances, 0.2)
+    assert torch.equal(torch.isfinite(shifted), expected)
+    assert not torch.equal(torch.isfinite(shifted), torch.isfinite(first))
+    body_prior_logits(pair.body_weights, pair.rest_pos, pair.joint_distances, 0.1)
+    assert len(calls) == 3
+
+
 def test_body_prior_is_per_pair_in_a_batch(garment) -> None:
     model = build(weight_reach=None)
     pairs = [make_pair(*garment, model.config, seed=1), make_pair(*tube(6, 8), model.config,
