@@ -134,7 +134,7 @@ def model_payload(model: GarmentDeformer) -> dict[str, Any]:
 
 #: Settings added to :class:`ModelConfig` after checkpoints were first saved, with the
 #: value that reproduces the models saved without them (not the current default).
-LEGACY_MODEL_SETTINGS = {"weight_prior": "none", "weight_reach": None}
+LEGACY_MODEL_SETTINGS = {"weight_prior": "none", "weight_reach": None, "motion_reach": False}
 
 
 def stored_model_config(stored: dict[str, Any], source: str = "<checkpoint>") -> ModelConfig:

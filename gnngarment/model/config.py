@@ -62,6 +62,13 @@ class ModelConfig:
             ``None`` (what checkpoints saved before it existed load as) allows
             every joint. The paper's head (``weight_prior: none``) has no prior to
             limit and ignores it.
+        motion_reach: the motion encoders see only the joints that ``weight_reach``
+            lets move some vertex of the garment: the other joints' rotations and the
+            velocities of the body-subset vertices nearest to them are zeroed, per
+            garment–body pair, so a wrist cannot move a skirt through the blend shapes
+            either. Without the ``body`` prior and a ``weight_reach`` there is no reach
+            and it is ignored. ``False`` (what checkpoints saved before it existed load
+            as) shows every joint.
     """
 
     garment_channels: list[int] = field(default_factory=lambda: [32, 64, 128, 128])
@@ -83,6 +90,7 @@ class ModelConfig:
     attention: str = "csr"
     weight_prior: str = "body"
     weight_reach: float | None = 0.2
+    motion_reach: bool = True
 
     def __post_init__(self) -> None:
         # Checked on construction, like every other config dataclass: an inconsistent

@@ -55,6 +55,9 @@ class DeformerContext:
             ``flatten(X^fuse) ⊙ E^t2`` is zero there for every frame, so the embedding
             GATs read only these columns — the same output, and no gradient is lost
             (a ReLU passes none back through a zero).
+        motion_mask: ``(P, 75)`` and velocity_mask ``(P, 3 N_b')``, 1 where a pair's
+            motion encoders see the input and 0 where ``motion_reach`` hides it
+            (:func:`motion_input_masks`), or ``None`` when they see everything.
     """
 
     fused: torch.Tensor
@@ -63,6 +66,8 @@ class DeformerContext:
     hierarchies: list[PoolHierarchy]
     prior_logits: torch.Tensor | None = None
     active_channels: torch.Tensor | None = None
+    motion_mask: torch.Tensor | None = None
+    velocity_mask: torch.Tensor | None = None
     _graphs: dict[int, GraphLevels] = field(default_factory=dict, repr=False)
 
     @property
@@ -180,9 +185,18 @@ class GarmentDeformer(nn.Module):
                                                      p.joint_distances, self.config.weight_reach)
                                    for p in pairs])
                         if self.weight_head.body_prior else None)
+        motion_mask = velocity_mask = None
+        if (self.config.motion_reach and self.config.weight_reach is not None
+                and prior_logits is not None):
+            offsets = _offsets(sizes)
+            masks = [motion_input_masks(prior_logits[offsets[p]:offsets[p + 1]],
+                                        pair.body_distances) for p, pair in enumerate(pairs)]
+            motion_mask = torch.stack([m for m, _ in masks])
+            velocity_mask = torch.stack([v for _, v in masks])
         return DeformerContext(fused=fused, rest_pos=torch.cat([p.rest_pos for p in pairs]),
                                ptr=_offsets(sizes), hierarchies=[p.hierarchy for p in pairs],
-                               prior_logits=prior_logits, active_channels=_active_channels(fused))
+                               prior_logits=prior_logits, active_channels=_active_channels(fused),
+                               motion_mask=motion_mask, velocity_mask=velocity_mask)
 
     # ---------------------------------------------------------------- per frame
     def forward(self, context: DeformerContext, motion_windows: torch.Tensor,
@@ -201,6 +215,9 @@ class GarmentDeformer(nn.Module):
         pairs, frames = context.num_pairs, motion_windows.shape[1]
         _check_frames(motion_windows, velocity_windows, joint_transforms, pairs, self.config)
         width = self.config.feature_channels
+        if context.motion_mask is not None and context.velocity_mask is not None:
+            motion_windows = motion_windows * context.motion_mask[:, None, None, :]
+            velocity_windows = velocity_windows * context.velocity_mask[:, None, None, :]
         pose_code, _ = self.pose_encoder(motion_windows.flatten(0, 1))       # (P·B, F)
         velocity_code, _ = self.velocity_encoder(velocity_windows.flatten(0, 1))  # (P·B, S·F)
         pose_code = pose_code.view(pairs, frames, width)
@@ -251,6 +268,22 @@ class GarmentDeformer(nn.Module):
             graph.unpool = [u.to(device) for u in graph.unpool]
             context._graphs[frames] = graph
         return context._graphs[frames]
+
+
+def motion_input_masks(prior_logits: torch.Tensor, body_distances: torch.Tensor
+                       ) -> tuple[torch.Tensor, torch.Tensor]:
+    """Which motion inputs a garment's encoders see under ``motion_reach``: the rotations
+    of the joints the weight reach lets move at least one of its vertices (a finite
+    prior logit), the root displacement always, and the velocities of the body-subset
+    vertices whose nearest joint is one of those.
+
+    Shapes: prior_logits ``(N, 24)`` (``-inf`` out of reach), body_distances
+    ``(N_b', 24)`` metres → ``(75,)`` and ``(3 N_b',)`` float masks (1 seen, 0 hidden).
+    """
+    joints = torch.isfinite(prior_logits).any(dim=0).to(prior_logits.dtype)     # (24,)
+    motion = torch.cat([joints.repeat_interleave(3), joints.new_ones(3)])
+    nearest = body_distances.argmin(dim=1)                                        # (N_b',)
+    return motion, joints[nearest].repeat_interleave(3)
 
 
 def _active_channels(fused: torch.Tensor) -> torch.Tensor | None:

@@ -267,3 +267,32 @@ def test_shipped_model_posed_vertices_equal_the_reference_path() -> None:
         actual = model(context, *inputs).posed
         expected = reference_forward(model, model.encode([pair]), inputs).posed
     assert float((actual - expected).abs().max()) < 1e-5
+
+
+def test_motion_reach_hides_the_joints_that_cannot_move_the_garment(garments) -> None:
+    """With ``motion_reach`` no output depends on the rotation of a joint the weight reach
+    keeps from every vertex, nor on the velocities of body vertices nearest to it; a
+    joint in reach still changes the output."""
+    config = tiny_config(motion_reach=True)
+    model = build(config)
+    pair = make_pair(*garments["disk"], config)
+    context = model.encode([pair])
+    seen = torch.isfinite(context.prior_logits).any(0)
+    assert 0 < int(seen.sum()) < 24
+    hidden, shown = int((~seen).nonzero()[0]), int(seen.nonzero()[0])
+    motion, velocity, transforms = frame_inputs(config, 1, 3)
+    reference = model(context, motion, velocity, transforms)
+
+    def posed_after(joint: int) -> torch.Tensor:
+        changed_motion = motion.clone()
+        changed_motion[..., 3 * joint:3 * joint + 3] += 0.5
+        nearest = pair.body_distances.argmin(1) == joint
+        changed_velocity = velocity.clone().view(1, 3, config.window, -1, 3)
+        changed_velocity[..., nearest, :] += 1.0
+        return model(context, changed_motion, changed_velocity.view_as(velocity),
+                     transforms).posed
+
+    torch.testing.assert_close(posed_after(hidden), reference.posed, rtol=0, atol=0)
+    assert (posed_after(shown) - reference.posed).abs().max() > 1e-6
+    for no_reach in (dict(weight_prior="none"), dict(weight_reach=None)):
+        assert build(tiny_config(**no_reach)).encode([pair]).motion_mask is None
