@@ -37,6 +37,7 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from gnngarment.data import PreparedDataset  # noqa: E402
+from gnngarment.evaluation.metrics import vertex_error  # noqa: E402
 
 #: Weight of the "rows sum to one" equation against the position residuals (metres):
 #: large enough that fitted rows sum to one within ~1e-3.
@@ -47,20 +48,23 @@ def joint_positions(rest: np.ndarray, transforms: np.ndarray) -> np.ndarray:
     """Every rest vertex moved rigidly by every joint.
 
     Shapes: rest ``(N, 3)`` metres, transforms ``(T, J, 4, 4)`` → ``(T, N, J, 3)``.
-    Linear blend skinning with weights ``w (N, J)`` is ``einsum('tnja,nj->tna', ·, w)``.
+    Linear blend skinning with weights ``w (N, J)`` is :func:`blend`.
     """
     homogeneous = np.concatenate([rest, np.ones((len(rest), 1))], axis=1)
     return np.einsum("tjab,nb->tnja", transforms, homogeneous)[..., :3]
 
 
-def skin(per_joint: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """``(T, N, J, 3)`` joint positions blended by ``(N, J)`` weights → ``(T, N, 3)``."""
+def blend(per_joint: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Linear blend skinning from :func:`joint_positions`: ``(T, N, J, 3)`` blended by
+    ``(N, J)`` weights → ``(T, N, 3)`` (the per-joint form the fit needs; the package's
+    :func:`gnngarment.body.skinning.skin` gives the same from transforms)."""
     return np.einsum("tnja,nj->tna", per_joint, weights)
 
 
 def vertex_error_mm(posed: np.ndarray, target: np.ndarray) -> float:
-    """E_verts: mean per-vertex distance (mm) between ``(T, N, 3)`` arrays in metres."""
-    return 1000.0 * float(np.linalg.norm(posed - target, axis=-1).mean())
+    """E_verts (mm) over all frames of ``(T, N, 3)`` arrays in metres (the evaluation's
+    :func:`~gnngarment.evaluation.metrics.vertex_error`)."""
+    return 1000.0 * float(vertex_error(posed, target).mean())
 
 
 def fit_weights(per_joint: list[np.ndarray], targets: list[np.ndarray], prior: np.ndarray,
@@ -105,8 +109,8 @@ def bounds_on_split(dataset: PreparedDataset) -> list[dict]:
         per_joint, target = _sequence_arrays(dataset, name)
         fitted = fit_weights([per_joint], [target], prior)
         rows.append({"sequence": name, "type": garment.garment_type,
-                     "body skinning": vertex_error_mm(skin(per_joint, prior), target),
-                     "fitted to itself": vertex_error_mm(skin(per_joint, fitted), target)})
+                     "body skinning": vertex_error_mm(blend(per_joint, prior), target),
+                     "fitted to itself": vertex_error_mm(blend(per_joint, fitted), target)})
         print(f"  {name}: {rows[-1]['body skinning']:.2f} / {rows[-1]['fitted to itself']:.2f}",
               file=sys.stderr, flush=True)
     return rows
@@ -127,11 +131,11 @@ def transfer_bounds(dataset: PreparedDataset, pairs: int,
         held_joints, held_target = _sequence_arrays(dataset, names[0])
         others = [_sequence_arrays(dataset, name) for name in names[1:]]
         row = {"sequence": names[0], "type": garment.garment_type, "fitted on": len(others),
-               "body skinning": vertex_error_mm(skin(held_joints, prior), held_target)}
+               "body skinning": vertex_error_mm(blend(held_joints, prior), held_target)}
         for regularisation in regularisations:
             fitted = fit_weights([p for p, _ in others], [y for _, y in others], prior,
                                  regularisation)
-            row[f"λ={regularisation:g}"] = vertex_error_mm(skin(held_joints, fitted), held_target)
+            row[f"λ={regularisation:g}"] = vertex_error_mm(blend(held_joints, fitted), held_target)
         rows.append(row)
         print(f"  {names[0]}: " + ", ".join(f"{k} {v:.2f}" for k, v in row.items()
                                            if isinstance(v, float)), file=sys.stderr, flush=True)

@@ -181,16 +181,15 @@ class GarmentDeformer(nn.Module):
         body = self.body_encoder(torch.stack([pair.body_distances for pair in pairs]))
         fused = garment * body[pair_of_vertex]
         # Checked above: every pair has body weights when the head has the prior.
-        prior_logits = (torch.cat([body_prior_logits(p.body_weights, p.rest_pos,
-                                                     p.joint_distances, self.config.weight_reach)
-                                   for p in pairs])
-                        if self.weight_head.body_prior else None)
+        pair_logits = ([body_prior_logits(p.body_weights, p.rest_pos, p.joint_distances,
+                                          self.config.weight_reach) for p in pairs]
+                       if self.weight_head.body_prior else None)
+        prior_logits = None if pair_logits is None else torch.cat(pair_logits)
         motion_mask = velocity_mask = None
         if (self.config.motion_reach and self.config.weight_reach is not None
-                and prior_logits is not None):
-            offsets = _offsets(sizes)
-            masks = [motion_input_masks(prior_logits[offsets[p]:offsets[p + 1]],
-                                        pair.body_distances) for p, pair in enumerate(pairs)]
+                and pair_logits is not None):
+            masks = [motion_input_masks(logits, pair.body_distances)
+                     for logits, pair in zip(pair_logits, pairs, strict=True)]
             motion_mask = torch.stack([m for m, _ in masks])
             velocity_mask = torch.stack([v for _, v in masks])
         return DeformerContext(fused=fused, rest_pos=torch.cat([p.rest_pos for p in pairs]),
