@@ -63,7 +63,10 @@ class CsrPattern:
     def transposed(self, values: torch.Tensor) -> torch.Tensor:
         """The transpose with the same values (for the backward pass; built once)."""
         perm, crow_t, col_t = self.transpose_structure()
-        return _csr(crow_t, col_t, values[perm], (self.shape[1], self.shape[0]))
+        # index_select, not values[perm]: advanced indexing was ~3x slower (1.1 vs 0.4 ms
+        # for 386k values), once per CSR product in every training step's backward.
+        return _csr(crow_t, col_t, values.index_select(0, perm),
+                    (self.shape[1], self.shape[0]))
 
     def transpose_structure(self) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         """``(perm, crow_t, col_t)`` of the transpose (built on first use, cached)."""

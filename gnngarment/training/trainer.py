@@ -76,6 +76,34 @@ def _distributed() -> tuple[int, int]:
     return 0, 1
 
 
+def rank_share(batches: list, rank: int, world: int) -> list:
+    """Rank ``rank``'s batches of an epoch: every ``world``-th, after padding the list
+    with its first batches to a multiple of ``world`` (as torch's DistributedSampler
+    pads): every rank must take as many steps as the others, since DDP's gradient
+    all-reduce waits for all of them."""
+    if batches and len(batches) % world:
+        padded = -(-len(batches) // world) * world
+        batches = [batches[index % len(batches)] for index in range(padded)]
+    return batches[rank::world]
+
+
+def mean_over_ranks(sums: dict[str, float], count: int) -> dict[str, float]:
+    """``sums / count`` per key, over the batches of every rank: each rank trains on its
+    own share of the epoch, and the stage schedule watches a training metric, so ranks
+    that each averaged only their own batches could disagree on a stage switch (one
+    rank in the next stage, the other not: DDP then waits forever). With one process,
+    the plain mean. Every rank must pass the same keys."""
+    names = sorted(sums)
+    if torch.distributed.is_available() and torch.distributed.is_initialized():
+        totals = torch.tensor([float(count)] + [sums[name] for name in names],
+                              dtype=torch.float64)
+        torch.distributed.all_reduce(totals)
+        count, values = int(totals[0]), totals[1:].tolist()
+    else:
+        values = [sums[name] for name in names]
+    return {name: value / max(count, 1) for name, value in zip(names, values, strict=True)}
+
+
 class Trainer:
     """Train a :class:`GarmentDeformer` on a prepared cache.
 
@@ -185,7 +213,7 @@ class Trainer:
         try:
             while self.epoch < last_epoch and self.stages.stage != "done":
                 set_stage(self.model, self.stages.stage)
-                self._wrap_for_stage()
+                self.wrap_for_stage()
                 metrics = self.train_epoch()
                 if self.validation_data is not None and (
                         (self.epoch + 1) % self.config.validate_every == 0):
@@ -210,9 +238,10 @@ class Trainer:
                 "switches": self.stages.switches,
                 "last": self.history[-1] if self.history else {}}
 
-    def _wrap_for_stage(self) -> None:
+    def wrap_for_stage(self) -> None:
         """With several processes, (re)wrap in DDP whenever the trainable set changes:
-        DDP only synchronises the parameters that required gradients when it was built."""
+        DDP only synchronises the parameters that required gradients when it was built.
+        Call after :func:`set_stage`."""
         if self.world == 1 or self._wrapped_stage == self.stages.stage:
             return
         self.step_module = nn.parallel.DistributedDataParallel(
@@ -229,7 +258,7 @@ class Trainer:
         rng = np.random.default_rng([config.seed, self.epoch])
         groups = list(self.train_data.batches(config.pairs_per_batch, config.frames_per_pair,
                                               rng))
-        groups = groups[self.rank::self.world]
+        groups = rank_share(groups, self.rank, self.world)
         sums: dict[str, float] = {}
         count = 0
         started = time.perf_counter()
@@ -242,7 +271,7 @@ class Trainer:
                 sums[name] = sums.get(name, 0.0) + term
             sums["loss"] = sums.get("loss", 0.0) + value
             bar.set_postfix(loss=f"{value:.4g}")
-        metrics = {name: value / max(count, 1) for name, value in sums.items()}
+        metrics = mean_over_ranks(sums, count)
         metrics["vertex_error_mm"] = 1000 * math.sqrt(metrics.get("vertex", 0.0))
         metrics["seconds"] = time.perf_counter() - started
         return metrics
@@ -272,26 +301,28 @@ class Trainer:
     @torch.no_grad()
     def validate(self) -> dict[str, float]:
         """Mean vertex error (mm, RMS per vertex) and collision term on the validation
-        split, every frame of every sequence."""
+        split, every frame of every sequence (with several processes each evaluates
+        every ``world``-th sequence, and all get the mean over all of them)."""
         from gnngarment.training.objective import loss_terms
 
         data = self.validation_data
         assert data is not None
         self.model.eval()
-        sums: dict[str, float] = {}
+        watched = ["vertex", "collision"]
+        # Every key present even on a rank with no sequence: mean_over_ranks sums by key.
+        sums = dict.fromkeys(watched, 0.0)
         count = 0
-        for name in data.sequence_names:
+        for name in data.sequence_names[self.rank::self.world]:
             frames = np.arange(data.frame_counts[name])
             for start in range(0, len(frames), self.config.frames_per_pair):
                 chunk = frames[start:start + self.config.frames_per_pair]
                 batch = data.batch([(name, chunk)])
                 output = TrainingStep(self.model)(batch)
-                terms = loss_terms(output, batch, ["vertex", "collision"],
-                                   self.config.collision_margin)
+                terms = loss_terms(output, batch, watched, self.config.collision_margin)
                 for key, value in terms.items():
-                    sums[key] = sums.get(key, 0.0) + float(value) * len(chunk)
+                    sums[key] += float(value) * len(chunk)
                 count += len(chunk)
-        metrics = {key: value / max(count, 1) for key, value in sums.items()}
+        metrics = mean_over_ranks(sums, count)
         metrics["vertex_error_mm"] = 1000 * math.sqrt(metrics["vertex"])
         return metrics
 

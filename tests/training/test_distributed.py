@@ -35,3 +35,43 @@ def test_torchrun_with_two_processes_trains_and_checkpoints(tmp_path: Path) -> N
     assert payload["epoch"] == 2 and payload["schedule"]["stage"] == "physics_strain"
     # Stage 2 trained the physics submodule in both processes (weights left zero-init).
     assert torch.count_nonzero(payload["model_state"]["physics_processor.output.lin.weight"]) > 0
+
+
+def _mean_in_rank(rank: int, init_file: str, results: str) -> None:
+    import json
+
+    from gnngarment.training.trainer import mean_over_ranks
+
+    torch.distributed.init_process_group("gloo", init_method=f"file://{init_file}",
+                                         rank=rank, world_size=2)
+    try:
+        # Rank 0 saw 3 batches of loss 1, rank 1 one batch of loss 5: the epoch's mean
+        # is 2 on both ranks (each rank's own mean, 1 and 5, would switch stages apart).
+        sums, count = ({"loss": 3.0, "vertex": 0.3}, 3) if rank == 0 else \
+            ({"vertex": 0.5, "loss": 5.0}, 1)
+        Path(results, f"{rank}.json").write_text(json.dumps(mean_over_ranks(sums, count)))
+    finally:
+        torch.distributed.destroy_process_group()
+
+
+@pytest.mark.timeout(120)
+def test_every_rank_gets_the_mean_over_all_ranks(tmp_path: Path) -> None:
+    import json
+
+    torch.multiprocessing.spawn(_mean_in_rank, args=(str(tmp_path / "init"), str(tmp_path)),
+                                nprocs=2)
+    means = [json.loads((tmp_path / f"{rank}.json").read_text()) for rank in (0, 1)]
+    assert means[0] == means[1]
+    assert means[0]["loss"] == pytest.approx(2.0)
+    assert means[0]["vertex"] == pytest.approx(0.2)
+
+
+def test_every_rank_takes_as_many_steps_and_all_batches_are_seen() -> None:
+    from gnngarment.training.trainer import rank_share
+
+    batches = list(range(5))
+    shares = [rank_share(batches, rank, 2) for rank in (0, 1)]
+    assert [len(share) for share in shares] == [3, 3]
+    assert set(shares[0]) | set(shares[1]) == set(batches)
+    assert rank_share(batches, 0, 1) == batches
+    assert [len(rank_share(batches[:1], rank, 3)) for rank in range(3)] == [1, 1, 1]
