@@ -10,6 +10,13 @@ mixed garments).
 
     .venv/bin/python benchmarks/training_speed.py [--config configs/train/demo.yaml]
         [--data data/demo] [--steps 10] [--threads 1] [--deterministic on|off|both]
+        [--processes 1] [--set pairs_per_batch=1 ...]
+
+``--processes P`` measures data-parallel training as ``torchrun --nproc_per_node P``
+runs it: P processes (gloo, ``--threads`` threads each), each stepping on its own batch
+with gradients averaged by DDP (:meth:`Trainer.wrap_for_stage`); frames/s counts every
+rank's frames over the slowest rank's time. With P processes one step trains on P
+batches; ``--set pairs_per_batch=...`` keeps the global batch of a one-process run.
 
 Freed memory is kept for reuse as every ``gnngarment`` command keeps it
 (:func:`gnngarment.allocator.keep_freed_memory`); ``GNNGARMENT_KEEP_FREED_MEMORY=0``
@@ -46,26 +53,31 @@ STAGES = ("supervised", "physics", "physics_strain")
 
 
 def measure(config_path: Path, data: Path, steps: int, threads: int,
-            deterministic: bool = True) -> dict:
+            deterministic: bool = True, overrides: list[str] | None = None) -> dict:
     """Seconds per optimiser step (:meth:`Trainer.step`) for each stage, the first step of
-    each stage discarded as a warm-up. Returns a JSON-able dict."""
+    each stage discarded as a warm-up. Returns a JSON-able dict. Inside a process group
+    (``--processes``) every rank steps on its own batches and the figures are the
+    group's: frames of all ranks, the slowest rank's seconds."""
     config = load_training_config(config_path, [f"data={data}", f"threads={threads}",
-                                                f"deterministic={deterministic}"])
+                                                f"deterministic={deterministic}",
+                                                *(overrides or [])])
     dataset = PreparedDataset(config.data, "train", config.model.window)
     trainer = Trainer(config, dataset, None, progress=False)
-    trainer.step_module.train()
+    rank, world = trainer.rank, trainer.world
     rng = np.random.default_rng(config.seed)
     groups = list(dataset.batches(config.pairs_per_batch, config.frames_per_pair, rng))
     results = {"config": str(config_path), "data": str(data), "threads": threads,
-               "deterministic": deterministic,
+               "processes": world, "deterministic": deterministic,
                "pairs_per_batch": config.pairs_per_batch,
                "frames_per_pair": config.frames_per_pair, "stages": {}}
     for stage in STAGES:
         trainer.stages.stage = stage
         set_stage(trainer.model, stage)
+        trainer.wrap_for_stage()
+        trainer.step_module.train()
         times, frames, vertices = [], 0, 0
         for index in range(steps + 1):
-            items = groups[index % len(groups)]
+            items = groups[(index * world + rank) % len(groups)]
             tic = time.perf_counter()
             trainer.step(items)
             elapsed = time.perf_counter() - tic
@@ -76,10 +88,44 @@ def measure(config_path: Path, data: Path, steps: int, threads: int,
                 frames += len(chunk)
                 vertices += len(chunk) * len(dataset.garment_of(name).pair.rest_pos)
         seconds = float(np.sum(times))
+        median = float(np.median(times))
+        if world > 1:
+            totals = torch.tensor([frames, vertices], dtype=torch.float64)
+            slowest = torch.tensor([seconds, median], dtype=torch.float64)
+            torch.distributed.all_reduce(totals)
+            torch.distributed.all_reduce(slowest, op=torch.distributed.ReduceOp.MAX)
+            (frames, vertices), (seconds, median) = totals.tolist(), slowest.tolist()
         results["stages"][stage] = {
-            "seconds_per_step": seconds / steps, "median_seconds_per_step": float(np.median(times)),
+            "seconds_per_step": seconds / steps, "median_seconds_per_step": median,
             "frames_per_second": frames / seconds, "vertices_per_second": vertices / seconds}
     return results
+
+
+def _rank(rank: int, world: int, init_file: str, args: argparse.Namespace,
+          deterministic: bool, output: str) -> None:
+    """One process of ``--processes``: join the gloo group, measure, rank 0 writes."""
+    torch.distributed.init_process_group("gloo", init_method=f"file://{init_file}",
+                                         rank=rank, world_size=world)
+    try:
+        keep_freed_memory()
+        results = measure(args.config, args.data, args.steps, args.threads, deterministic,
+                          args.set)
+        if rank == 0:
+            Path(output).write_text(json.dumps(results))
+    finally:
+        torch.distributed.destroy_process_group()
+
+
+def measure_in_processes(args: argparse.Namespace, deterministic: bool) -> dict:
+    """:func:`measure` in ``args.processes`` processes (one gloo group, as torchrun)."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        output = Path(folder) / "results.json"
+        torch.multiprocessing.spawn(
+            _rank, args=(args.processes, str(Path(folder) / "init"), args, deterministic,
+                         str(output)), nprocs=args.processes)
+        return json.loads(output.read_text())
 
 
 def main() -> None:
@@ -89,22 +135,32 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=10)
     parser.add_argument("--threads", type=int, default=1)
     parser.add_argument("--deterministic", choices=("on", "off", "both"), default="on")
+    parser.add_argument("--processes", type=int, default=1,
+                        help="data-parallel processes (gloo + DDP, as torchrun runs them)")
+    parser.add_argument("--set", action="append", default=[],
+                        help="override a training setting, e.g. --set pairs_per_batch=1")
     parser.add_argument("--json", type=Path, help="also write the results here")
     args = parser.parse_args()
+    if args.processes < 1:
+        print(f"--processes must be >= 1, got {args.processes}", file=sys.stderr)
+        raise SystemExit(2)
     if not (args.data / "manifest.json").is_file():
         print(f"{args.data}: no prepared cache (build it with `gnngarment prepare --config "
               "configs/data/demo.yaml`, or `make demo`)", file=sys.stderr)
         raise SystemExit(2)
     # As `gnngarment train` does (GNNGARMENT_KEEP_FREED_MEMORY=0: glibc's defaults).
     kept = keep_freed_memory()
-    print(f"torch {torch.__version__}, {args.threads} thread(s), load average "
+    print(f"torch {torch.__version__}, {args.processes} process(es) × {args.threads} "
+          f"thread(s), load average "
           f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores, freed memory "
           f"{'kept for reuse' if kept else 'unmapped (glibc default)'}")
     modes = {"on": [True], "off": [False], "both": [False, True]}[args.deterministic]
-    runs = [measure(args.config, args.data, args.steps, args.threads, mode) for mode in modes]
+    runs = [measure(args.config, args.data, args.steps, args.threads, mode, args.set)
+            if args.processes == 1 else measure_in_processes(args, mode) for mode in modes]
     for results in runs:
         print(f"{results['pairs_per_batch']} pairs × {results['frames_per_pair']} frames per "
-              f"batch, {args.steps} steps per stage after one warm-up step, {args.data}, "
+              f"batch and process, {results['processes']} process(es), {args.steps} steps "
+              f"per stage after one warm-up step, {args.data}, "
               f"deterministic {'on' if results['deterministic'] else 'off'}")
         print("| stage | s/step (mean) | s/step (median) | frames/s | vertices/s |")
         print("|---|---|---|---|---|")
