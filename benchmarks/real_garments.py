@@ -11,13 +11,16 @@ animate it on a walk with the shipped (or a given) model, and print
 * the share of garment vertices inside the walking body after collision resolution
   and in the network's raw output (%, mean over frames; inside = more than 2 mm deep,
   the nearest-point sign of a dense body sampling);
+* the same share and the deepest vertex (mm, mean over frames of each frame's deepest)
+  for the network's raw output and for **body skinning** of the same fitted garment
+  (the body's weights transferred to it, no blend shapes: the baseline every user has);
 * the largest share of any vertex's skinning weight on joints whose body region is more
   than 20 cm from it (far weight, :func:`~gnngarment.evaluation.metrics.far_joint_weight`).
 
 Targets (issue 13): inside < 1 % after resolution; walking median distance within 1 cm
 of the source-body distance.
 
-    .venv/bin/python benchmarks/real_garments.py [--checkpoint PATH] [--motion walk]
+    .venv/bin/python benchmarks/real_garments.py [--checkpoint PATH] [--motion walk|FILE]
         [--shared ../shared] [--images docs/images/real_garments]
 """
 
@@ -36,6 +39,8 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from gnngarment.body import AnnyBodyModel, load_motion  # noqa: E402
+from gnngarment.body.skinning import skin  # noqa: E402
+from gnngarment.body.weight_transfer import transfer_body_weights  # noqa: E402
 from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs  # noqa: E402
 from gnngarment.evaluation.metrics import far_joint_weight  # noqa: E402
 from gnngarment.geometry.mesh_io import load_mesh  # noqa: E402
@@ -117,12 +122,16 @@ def main() -> None:
     body_model = AnnyBodyModel()
     shape = body_model.parse_shape("average")
     body = body_shape_inputs(body_model, shape, model.config.body_vertices)
-    frames = body_motion_inputs(body_model, shape, load_motion(args.motion, fps=30.0),
-                                model.config.body_vertices)
+    # A motion file is retargeted to the rest body's joints, as `gnngarment animate` does.
+    is_file = Path(args.motion).suffix != ""
+    motion = load_motion(args.motion, fps=30.0, **(
+        {"rest_joints": body_model.rest(shape).joints.numpy()} if is_file else {}))
+    frames = body_motion_inputs(body_model, shape, motion, model.config.body_vertices)
     print(f"checkpoint {args.checkpoint}, motion {args.motion} ({len(frames.vertices)} frames)")
     print("| garment | vertices | fit s | registration mm | median distance mm: source | "
-          "rest | walking | inside % resolved | inside % raw | far weight % max | animate s |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+          "rest | walking | inside % resolved | inside % raw | inside % body skinning | "
+          "deepest mm raw | deepest mm body skinning | far weight % max | animate s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for garment, source_name in SOURCE_BODIES.items():
         pos, faces = load_mesh(real / "garments" / f"{garment}.obj")
         source = load_mesh(real / "bodies" / f"{source_name}.obj")
@@ -134,13 +143,23 @@ def main() -> None:
         rest_distance = np.median(np.abs(distances(result.rest_pos, body.rest_vertices,
                                                    body.faces)))
         chosen = np.linspace(0, len(frames.vertices) - 1, args.frames_measured).round()
-        walking, inside, raw_inside = [], [], []
+        body_weights = transfer_body_weights(result.rest_pos, body.rest_vertices,
+                                             body.skinning_weights)
+        body_skinned = skin(torch.from_numpy(result.rest_pos).float(), None,
+                            torch.from_numpy(body_weights).float(),
+                            torch.from_numpy(result.joint_transforms).float()).numpy()
+        walking, inside, raw_inside, skinned_inside, raw_deepest, skinned_deepest = \
+            [], [], [], [], [], []
         for t in chosen.astype(int):
             resolved = distances(result.posed[t], frames.vertices[t], body.faces)
             raw = distances(result.raw_posed[t], frames.vertices[t], body.faces)
+            skinned = distances(body_skinned[t], frames.vertices[t], body.faces)
             walking.append(np.median(np.abs(resolved)))
             inside.append(np.mean(resolved < -INSIDE_DEPTH))
             raw_inside.append(np.mean(raw < -INSIDE_DEPTH))
+            skinned_inside.append(np.mean(skinned < -INSIDE_DEPTH))
+            raw_deepest.append(max(0.0, -raw.min()))
+            skinned_deepest.append(max(0.0, -skinned.min()))
         far = far_joint_weight(result.weights, result.rest_pos, body.rest_vertices,
                                body.skinning_weights)["max"]
         if args.images is not None:
@@ -149,6 +168,8 @@ def main() -> None:
               f"{1000 * placed.fitted.registration_error:.1f} | {1000 * source_distance:.1f} | "
               f"{1000 * rest_distance:.1f} | {1000 * np.mean(walking):.1f} | "
               f"{100 * np.mean(inside):.2f} | {100 * np.mean(raw_inside):.2f} | "
+              f"{100 * np.mean(skinned_inside):.2f} | {1000 * np.mean(raw_deepest):.1f} | "
+              f"{1000 * np.mean(skinned_deepest):.1f} | "
               f"{100 * far:.1f} | {seconds:.1f} |", flush=True)
 
 
