@@ -51,6 +51,10 @@ class StageConfig:
             before adding stretch + shear (blueprint: 20 epochs, 5 %).
         strain_window, strain_threshold: when the final stage ends.
         physics_scale: stage 2 multiplies the vertex and edge weights by this (0.1).
+        supervised_collision: not in the blueprint (0 = off): stage 1 also weights the
+            collision term by this. Stage 1 is the only stage that trains the skinning
+            weights, and they are what puts the raw output inside the body
+            (docs/limitations.md).
         max_epochs: per stage, a hard limit (0 = none).
     """
 
@@ -61,6 +65,7 @@ class StageConfig:
     strain_window: int = 20
     strain_threshold: float = 0.05
     physics_scale: float = 0.1
+    supervised_collision: float = 0.0
     max_epochs: list[int] = field(default_factory=lambda: [0, 0, 0])
 
 
@@ -122,6 +127,7 @@ class TrainingConfig:
             _check_at_least(f"stages.{name}_window", getattr(stages, f"{name}_window"), 1)
             _check_finite(f"stages.{name}_threshold", getattr(stages, f"{name}_threshold"))
         _check_finite("stages.physics_scale", stages.physics_scale)
+        _check_finite("stages.supervised_collision", stages.supervised_collision)
         if len(stages.max_epochs) != len(TRAINED_STAGES) or min(stages.max_epochs) < 0:
             raise ValueError(f"key 'stages.max_epochs': expected {len(TRAINED_STAGES)} epoch "
                              f"limits >= 0 ({', '.join(TRAINED_STAGES)}; 0 = none), got "

@@ -14,8 +14,10 @@ def stage_weights(stage: str, weights: LossWeights, stages: StageConfig) -> dict
     """The weight of every term in ``stage`` (0 = off)."""
     extra = {"blend_shape": weights.blend_shape} if weights.blend_shape > 0 else {}
     if stage == "supervised":
+        collision = ({"collision": stages.supervised_collision}
+                     if stages.supervised_collision > 0 else {})
         return {"vertex": weights.vertex, "edge": weights.edge, "normal": weights.normal,
-                **extra}
+                **collision, **extra}
     scaled = {"vertex": weights.vertex * stages.physics_scale,
               "edge": weights.edge * stages.physics_scale,
               "collision": weights.collision, "gravity": weights.gravity, **extra}

@@ -24,6 +24,14 @@ def test_each_stage_weights_its_terms() -> None:
     assert strain == pytest.approx({**physics, "stretch": 5.0, "shear": 2.0})
 
 
+def test_supervised_collision_weights_the_collision_term_in_stage_one_only() -> None:
+    weights = LossWeights()
+    stages = StageConfig(physics_scale=0.1, supervised_collision=100.0)
+    assert stage_weights("supervised", weights, stages) == {
+        "vertex": 100.0, "edge": 15.0, "normal": 50.0, "collision": 100.0}
+    assert stage_weights("physics", weights, stages)["collision"] == pytest.approx(1.5)
+
+
 def test_every_weighted_term_has_a_criterion() -> None:
     """Each loss weight of the config names a criterion, and an unknown name is refused."""
     assert {f.name for f in fields(LossWeights)} == set(CRITERIA)
