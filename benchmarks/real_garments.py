@@ -38,7 +38,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from gnngarment.body import AnnyBodyModel, load_motion  # noqa: E402
+from gnngarment.body import AnnyBodyModel, load_motion_for_body  # noqa: E402
 from gnngarment.body.skinning import skin  # noqa: E402
 from gnngarment.body.weight_transfer import transfer_body_weights  # noqa: E402
 from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs  # noqa: E402
@@ -123,9 +123,7 @@ def main() -> None:
     shape = body_model.parse_shape("average")
     body = body_shape_inputs(body_model, shape, model.config.body_vertices)
     # A motion file is retargeted to the rest body's joints, as `gnngarment animate` does.
-    is_file = Path(args.motion).suffix != ""
-    motion = load_motion(args.motion, fps=30.0, **(
-        {"rest_joints": body_model.rest(shape).joints.numpy()} if is_file else {}))
+    motion = load_motion_for_body(args.motion, body_model, shape, fps=30.0)
     frames = body_motion_inputs(body_model, shape, motion, model.config.body_vertices)
     print(f"checkpoint {args.checkpoint}, motion {args.motion} ({len(frames.vertices)} frames)")
     print("| garment | vertices | fit s | registration mm | median distance mm: source | "

@@ -5,8 +5,9 @@ Public API (shapes in each docstring):
 * skeleton: :data:`JOINT_NAMES`, :data:`JOINT_PARENTS`, :data:`NUM_JOINTS`,
   :func:`forward_kinematics`;
 * motions: :class:`Motion`, :class:`MotionError`, :func:`make_motion`,
-  :func:`list_motions`, :func:`load_motion`, :func:`load_amass_motion`,
-  :func:`load_bvh_motion`, :func:`load_cloth3d_motion`, :func:`motion_from_smpl`;
+  :func:`list_motions`, :func:`load_motion`, :func:`load_motion_for_body`,
+  :func:`load_amass_motion`, :func:`load_bvh_motion`, :func:`load_cloth3d_motion`,
+  :func:`motion_from_smpl`;
 * body models: :class:`BodyModel`, :class:`RestBody`, :class:`PosedBody`,
   :class:`AnnyBodyModel`, :class:`AnnyShape`, :data:`ANNY_PRESETS`,
   :func:`sample_anny_shapes`, :class:`SMPLBodyModel`, :func:`create_body_model`;
@@ -41,7 +42,7 @@ from gnngarment.body.features import (
     vertex_velocities,
 )
 from gnngarment.body.motion import Motion, MotionError
-from gnngarment.body.motion_io import load_motion
+from gnngarment.body.motion_io import load_motion, load_motion_for_body
 from gnngarment.body.procedural import MOTION_LIBRARY, list_motions, make_motion
 from gnngarment.body.sampling import farthest_point_sampling
 from gnngarment.body.skeleton import (
@@ -83,6 +84,7 @@ __all__ = [
     "load_bvh_motion",
     "load_cloth3d_motion",
     "load_motion",
+    "load_motion_for_body",
     "make_motion",
     "motion_features",
     "motion_from_smpl",

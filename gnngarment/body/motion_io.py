@@ -1,4 +1,5 @@
-"""Reading a motion by name or file: :func:`load_motion` picks the loader.
+"""Reading a motion by name or file: :func:`load_motion` picks the loader;
+:func:`load_motion_for_body` retargets a file onto the body it will play on.
 
 One loader per format, each returning a canonical :class:`~gnngarment.body.motion.Motion`
 (Z up, T-pose rest, world-aligned local axes; see :mod:`gnngarment.body.skeleton`):
@@ -15,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -23,7 +25,10 @@ from gnngarment.body.cloth3d_motion import load_cloth3d_motion
 from gnngarment.body.motion import Motion, MotionError
 from gnngarment.body.smpl_motion import load_npz_motion
 
-__all__ = ["MOTION_FILE_TYPES", "load_motion"]
+if TYPE_CHECKING:
+    from gnngarment.body.body_model import BodyModel
+
+__all__ = ["MOTION_FILE_TYPES", "load_motion", "load_motion_for_body"]
 
 MOTION_FILE_TYPES = (".npz", ".bvh", ".mat")
 
@@ -90,3 +95,26 @@ def load_motion(
     else:
         motion = load_cloth3d_motion(path)
     return motion.resample(fps) if fps is not None and abs(fps - motion.fps) > 1e-9 else motion
+
+
+def load_motion_for_body(
+    spec: str | Path,
+    body_model: BodyModel,
+    shape: Any = None,
+    fps: float | None = None,
+    joint_map: Mapping[str, str | None] | str | Path | None = None,
+    up_axis: str = "auto",
+    **procedural,
+) -> Motion:
+    """:func:`load_motion` for a motion that will play on ``body_model`` in ``shape``: a
+    file (a spec with a suffix) is retargeted onto that shape's rest skeleton
+    (``rest_joints``: a BVH's rest pose and units); a procedural name gets the
+    ``procedural`` keyword arguments (duration, ...), which a file does not take.
+
+    Raises:
+        MotionError: as :func:`load_motion`.
+    """
+    if Path(spec).suffix:
+        return load_motion(spec, fps, joint_map, up_axis,
+                           rest_joints=body_model.rest(shape).joints.numpy())
+    return load_motion(spec, fps, joint_map, up_axis, **procedural)

@@ -72,7 +72,7 @@ def attribute_command(
     from gnngarment.body.config import BodyConfig
     from gnngarment.body.factory import create_body_model
     from gnngarment.body.motion import MotionError
-    from gnngarment.body.motion_io import load_motion
+    from gnngarment.body.motion_io import load_motion_for_body
     from gnngarment.body.smpl_model import SMPLModelError
     from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs
     from gnngarment.geometry.errors import MeshError
@@ -114,11 +114,9 @@ def attribute_command(
             body_shape = body.parse_shape(shape)
             count = model.config.body_vertices
             shape_inputs = body_shape_inputs(body, body_shape, count)
-            is_file = bool(Path(motion).suffix)
-            frames = body_motion_inputs(body, body_shape, load_motion(
-                motion, fps=fps, joint_map=joint_map, up_axis=motion_up_axis,
-                **({"rest_joints": body.rest(body_shape).joints.numpy()} if is_file
-                   else {"duration": duration})), count)
+            frames = body_motion_inputs(body, body_shape, load_motion_for_body(
+                motion, body, body_shape, fps=fps, joint_map=joint_map,
+                up_axis=motion_up_axis, duration=duration), count)
     except (MotionError, SMPLModelError, ValueError) as error:
         raise fail(str(error)) from None
     if source is not None:

@@ -413,7 +413,7 @@ def _load_body_and_motion(body_shape: str, motion: str, fps: float, duration: fl
                           joint_map: Path | None = None, motion_up_axis: str = "auto"):
     """Anny body, its shape and a motion (procedural name or file, retargeted onto this
     shape's rest skeleton), or a clear failure."""
-    from gnngarment.body import AnnyBodyModel, MotionError, load_motion
+    from gnngarment.body import AnnyBodyModel, MotionError, load_motion_for_body
 
     body_model = AnnyBodyModel()
     try:
@@ -421,11 +421,9 @@ def _load_body_and_motion(body_shape: str, motion: str, fps: float, duration: fl
     except (ValueError, OSError) as error:
         raise fail(f"--body-shape {body_shape}: {error}") from None
     try:
-        is_file = bool(Path(motion).suffix)
-        motion_value = load_motion(
-            motion, fps=fps, joint_map=joint_map, up_axis=motion_up_axis,
-            **({"rest_joints": body_model.rest(shape).joints.numpy()} if is_file
-               else {"duration": duration}))
+        motion_value = load_motion_for_body(motion, body_model, shape, fps=fps,
+                                            joint_map=joint_map, up_axis=motion_up_axis,
+                                            duration=duration)
     except (MotionError, ValueError, OSError) as error:
         raise fail(f"--motion {motion}: {error}") from None
     return body_model, shape, motion_value

@@ -94,7 +94,7 @@ def mean_over_ranks(sums: dict[str, float], count: int) -> dict[str, float]:
     rank in the next stage, the other not: DDP then waits forever). With one process,
     the plain mean. Every rank must pass the same keys."""
     names = sorted(sums)
-    if torch.distributed.is_available() and torch.distributed.is_initialized():
+    if _distributed()[1] > 1:
         totals = torch.tensor([float(count)] + [sums[name] for name in names],
                               dtype=torch.float64)
         torch.distributed.all_reduce(totals)
