@@ -4,13 +4,24 @@ A BVH file is read in three steps:
 
 1. **Names** (:func:`map_bvh_joints`): each of the 24 canonical joints gets a BVH joint
    from :data:`BVH_JOINT_CANDIDATES` (CMU/cgspeed, CMU "LeftHip/LeftKnee/LeftAnkle",
-   Mixamo, MotionBuilder/HumanIK, 3ds Max Biped, Unreal, SMPL names), compared after
+   CMU's original ASF names ``lfemur/ltibia/upperback/thorax/lhumerus/lradius``, the
+   Poser-style ``hip/abdomen/chest/lThigh/lShldr`` of most CMU conversions, Mixamo,
+   MotionBuilder/HumanIK, 3ds Max Biped, Unreal, SMPL names), compared after
    :func:`normalize_joint_name` (namespace and ``mixamorig``/``Bip01`` prefixes dropped,
    case and punctuation ignored), or from a user joint map (:func:`read_joint_map`). A
    name that means two joints in different conventions (``LeftShoulder``: the collar
    in cgspeed/Mixamo, the upper arm in CMU's own naming; ``LeftFoot``: ankle or toes;
    ``LeftHand``: wrist or hand; ``Spine``) is decided by the hierarchy: it takes the
    upper joint only when a joint named for the lower one follows it in the tree.
+
+   **Spine spread**: a file with fewer spine joints than our three lets one joint stand
+   for several. Each spine joint it lacks joins the nearest mapped spine joint below
+   it, and that joint's local rotation ``R`` (about its canonical parent) is shared
+   equally: with ``k`` joints, each turns by ``R^(1/k)``, the same axis and ``1/k`` of
+   the angle, so the top one ends exactly where the file's joint does and nothing above
+   it changes. Poser-style ``abdomen/chest`` gives spine1 = abdomen and spine2 = spine3
+   = ``chest^(1/2)``; a lone ``Spine`` under the neck gives spine1..spine3 a third each.
+   A joint map's ``null`` keeps a joint out of the spread (at rest) and ends the run.
 2. **Rest-pose retargeting**: the BVH rest pose (all channels zero) is often not our
    T-pose (CMU: arms down, legs splayed). For each limb joint ``j`` (hip, knee, ankle,
    shoulder, elbow, wrist) with mapped child ``c``, ``A_j`` is the shortest arc taking
@@ -74,18 +85,20 @@ class UnmappedJointsWarning(UserWarning):
 # preference. "<side>" is left/right, "<s>" is l/r. Lists are written for the left side.
 _LEFT_CANDIDATES: dict[str, tuple[str, ...]] = {
     "hip": ("<side>upleg", "<side>thigh", "<side>upperleg", "<s>upleg", "<s>thigh",
-            "thigh<s>", "upperleg<s>", "<side>hip", "<s>hip"),
+            "thigh<s>", "upperleg<s>", "<side>hip", "<s>hip", "<s>femur"),
     "knee": ("<side>leg", "<side>shin", "<side>knee", "<side>lowerleg", "<side>calf",
-             "<s>leg", "<s>shin", "<s>knee", "<s>calf", "calf<s>", "lowerleg<s>", "shin<s>"),
+             "<s>leg", "<s>shin", "<s>knee", "<s>calf", "calf<s>", "lowerleg<s>", "shin<s>",
+             "<s>tibia"),
     "ankle": ("<side>ankle", "<s>ankle", "ankle<s>", "<side>foot", "<s>foot", "foot<s>"),
     "foot": ("<side>toebase", "<side>toe", "<side>toes", "<side>ball", "<s>toebase", "<s>toe",
              "<s>toe0", "<s>toes", "ball<s>", "toe<s>", "<side>foot", "<s>foot"),
     "collar": ("<side>collar", "<side>clavicle", "<s>collar", "<s>clavicle", "clavicle<s>",
                "<side>shoulder", "<s>shoulder"),
     "shoulder": ("<side>arm", "<side>uparm", "<side>upperarm", "<s>uparm", "<s>upperarm",
-                 "upperarm<s>", "<s>shldr", "<side>shoulder", "<s>shoulder", "<s>arm"),
+                 "upperarm<s>", "<s>shldr", "<side>shoulder", "<s>shoulder", "<s>arm",
+                 "<s>humerus"),
     "elbow": ("<side>forearm", "<side>lowarm", "<side>lowerarm", "<side>elbow", "<s>forearm",
-              "<s>lowarm", "<s>lowerarm", "lowerarm<s>", "<s>elbow"),
+              "<s>lowarm", "<s>lowerarm", "lowerarm<s>", "<s>elbow", "<s>radius"),
     "wrist": ("<side>wrist", "<s>wrist", "<side>hand", "<s>hand", "hand<s>"),
     "hand": ("<side>fingerbase", "<side>fingers", "<s>fingers", "<side>handmiddle1",
              "<side>handindex1", "<side>finger2", "<s>finger2", "middle01<s>",
@@ -101,9 +114,11 @@ def _sided(templates: tuple[str, ...], side: str) -> tuple[str, ...]:
 BVH_JOINT_CANDIDATES: dict[str, tuple[str, ...]] = {
     "pelvis": ("hips", "pelvis", "hip", "root"),
     "spine1": ("lowerback", "spine", "spine01", "abdomen", "spine1"),
-    "spine2": ("spine", "spine1", "spine02", "chest", "spine2"),
-    "spine3": ("spine1", "spine2", "spine03", "chest2", "chest", "upperchest", "spine3"),
-    "neck": ("neck", "neck01", "lowerneck"),
+    "spine2": ("spine", "spine1", "spine02", "chest", "spine2", "upperback"),
+    "spine3": ("spine1", "spine2", "spine03", "chest2", "chest", "upperchest", "spine3", "thorax"),
+    # CMU's upperneck before lowerneck: lowerneck sits on the thorax (offset 0), so the
+    # whole neck bend folds into ours, as CMU 131's lowerneck folds into its Neck.
+    "neck": ("neck", "neck01", "upperneck", "lowerneck"),
     "head": ("head",),
     **{
         f"{side}_{part}": _sided(templates, side)
@@ -113,7 +128,8 @@ BVH_JOINT_CANDIDATES: dict[str, tuple[str, ...]] = {
 }
 BVH_JOINT_CANDIDATES = {name: BVH_JOINT_CANDIDATES[name] for name in JOINT_NAMES}
 
-# Joints a BVH may lack (left at rest, with a warning); any other missing joint is an error.
+# Joints a BVH may lack (with a warning: left at rest, or spine2/spine3 share the rotation of
+# the spine joint below, see _spine_runs); any other missing joint is an error.
 BVH_OPTIONAL_JOINTS = frozenset(
     {"spine2", "spine3", "neck", "L_collar", "R_collar", "L_foot", "R_foot", "L_hand", "R_hand"}
 )
@@ -222,6 +238,17 @@ def map_bvh_joints(
             or the mapped joints do not form the canonical tree (e.g. a knee mapped
             outside its leg).
     """
+    return _choose_bvh_joints(names, parents, joint_map, source)[0]
+
+
+def _choose_bvh_joints(
+    names: list[str],
+    parents: list[int],
+    joint_map: Mapping[str, str | None] | str | Path | None,
+    source: str,
+) -> tuple[dict[str, str], frozenset[str]]:
+    """:func:`map_bvh_joints`'s mapping, and the canonical joints the user's joint map
+    sets to ``null`` (held at rest, never given a share of another joint's rotation)."""
     where = f"{source}: " if source else ""
     map_source = source
     if isinstance(joint_map, (str, Path)):
@@ -319,6 +346,18 @@ def map_bvh_joints(
                 if picks:
                     chosen[j] = picks[0]
                     break
+    # A spine with fewer joints than ours (abdomen/chest, Spine/Chest, Spine/Spine1) ends in
+    # a name that also fits spine3 ("chest"), which neither pass gives an optional joint;
+    # it plays spine2, and the loader spreads its rotation over spine2 and spine3.
+    for joint in ("spine2", "spine3"):
+        j = JOINT_INDEX[joint]
+        if j in chosen or j in excluded:
+            continue
+        for candidate in BVH_JOINT_CANDIDATES[joint]:
+            picks = [b for b in normalized.get(candidate, ()) if fits(j, b)]
+            if picks:
+                chosen[j] = picks[0]
+                break
 
     # The mapped joints must nest like the canonical tree: each one below the joint of its
     # nearest mapped canonical ancestor (other mapped joints may sit between, as 3ds Max
@@ -346,7 +385,8 @@ def map_bvh_joints(
             f"names like {', '.join(BVH_JOINT_CANDIDATES[first][:4])}; pass a joint map "
             "(--joint-map FILE) naming the file's joints)"
         )
-    return {JOINT_NAMES[j]: names[b] for j, b in sorted(chosen.items())}
+    mapping = {JOINT_NAMES[j]: names[b] for j, b in sorted(chosen.items())}
+    return mapping, frozenset(JOINT_NAMES[j] for j in excluded)
 
 
 # ---- small rotation helpers (numpy, batched) ------------------------------------------------
@@ -397,6 +437,42 @@ def _frame_alignment(
     if a is None or b is None:
         return _shortest_arc(canonical[0], bvh[0])
     return b @ a.T
+
+
+def _spine_runs(mapped: set[str], held: frozenset[str]) -> list[list[str]]:
+    """Canonical spine chains ``[base, joint, …]`` that one BVH joint stands for: every
+    spine joint the file lacks joins the nearest mapped spine joint below it, unless a
+    joint map holds it (or one between) at rest. Only runs of two or more are listed:
+    abdomen/chest → ``[["spine2", "spine3"]]``; a lone ``Spine`` →
+    ``[["spine1", "spine2", "spine3"]]``."""
+    runs: list[list[str]] = []
+    for joint in ("spine1", "spine2", "spine3"):
+        if joint in mapped:
+            runs.append([joint])
+        elif joint in held or not runs:
+            runs.append([])  # a held joint ends the run below it
+        else:
+            runs[-1].append(joint)
+    return [run for run in runs if len(run) > 1 and run[0] in mapped]
+
+
+def _spread_rotation(global_rotations: np.ndarray, chain: list[int]) -> None:
+    """Share the local rotation of ``chain[0]`` equally along the chain, in place.
+
+    ``global_rotations`` ``(T, 24, 3, 3)``; ``chain``: canonical joints, each the parent of
+    the next, the base holding the whole rotation ``R`` about its parent. Each joint gets
+    ``R^(1/k)`` (the same axis, 1/k of the angle; k = len(chain)), so the top of the chain
+    keeps its global rotation and everything above it is unchanged.
+    """
+    from scipy.spatial.transform import Rotation
+
+    parent_global = global_rotations[:, JOINT_PARENTS[chain[0]]]
+    whole = np.swapaxes(parent_global, -1, -2) @ global_rotations[:, chain[0]]
+    rotvec = Rotation.from_matrix(whole).as_rotvec()  # (T, 3)
+    for step, joint in enumerate(chain[:-1], start=1):
+        share = Rotation.from_rotvec(rotvec * (step / len(chain))).as_matrix()
+        global_rotations[:, joint] = parent_global @ share
+    global_rotations[:, chain[-1]] = parent_global @ whole
 
 
 # ---- reading and forward kinematics --------------------------------------------------------
@@ -522,9 +598,11 @@ def load_bvh_motion(
     """A BVH file (parsed by the PyPI ``bvh`` package) retargeted onto the 24 joints.
 
     See the module docstring for the name table, the rest-pose retargeting and units.
-    Unmapped intermediate joints (CMU's ``LHipJoint``, ``lowerneck``; cgspeed ``Neck1``)
-    fold into their mapped neighbours; unmapped leaves (fingers, thumbs) are dropped;
-    both are listed in an :class:`UnmappedJointsWarning`.
+    Unmapped intermediate joints (CMU's ``LHipJoint``/``lhipjoint``, ``lowerneck``,
+    ``lButtock``; cgspeed ``Neck1``) fold into their mapped neighbours; unmapped leaves
+    (fingers, thumbs, eyes) are dropped; both are listed in an
+    :class:`UnmappedJointsWarning`, with the canonical joints left at rest and the spine
+    joints that share one file joint's rotation.
 
     Args:
         path: the ``.bvh`` file.
@@ -560,18 +638,23 @@ def load_bvh_motion(
         raise MotionError(f"{path}: rest_joints must be finite ({NUM_JOINTS}, 3), got "
                           f"{rest_joints.shape}")  # fmt: skip
     names, parents, offsets, frames, frame_time, channels = _read_bvh(path)
-    mapping = map_bvh_joints(names, parents, joint_map, source=str(path))
+    mapping, held = _choose_bvh_joints(names, parents, joint_map, str(path))
     index = {name: i for i, name in enumerate(names)}
     bvh_of = {joint: index[name] for joint, name in mapping.items()}
+    spine_runs = _spine_runs(set(mapping), held)
 
     used = set(bvh_of.values())
     unmapped = [n for n in names if index[n] not in used]
-    missing = [j for j in JOINT_NAMES if j not in mapping]
-    if unmapped or missing:
+    shared = {joint for run in spine_runs for joint in run[1:]}
+    missing = [j for j in JOINT_NAMES if j not in mapping and j not in shared]
+    if unmapped or missing or shared:
+        spread = "".join(
+            f"; '{mapping[run[0]]}' spread over {', '.join(run)}" for run in spine_runs
+        )
         warnings.warn(
             f"{path}: BVH joints not mapped onto the canonical skeleton: "
             f"{', '.join(unmapped) or 'none'}; canonical joints left at rest: "
-            f"{', '.join(missing) or 'none'}",
+            f"{', '.join(missing) or 'none'}{spread}",
             UnmappedJointsWarning,
             stacklevel=2,
         )
@@ -665,6 +748,10 @@ def load_bvh_motion(
             canonical_global[:, j] = correction @ moved @ alignment[j]
             continue
         canonical_global[:, j] = global_rot[:, b] @ alignment[j]
+
+    # A file spine joint that stands for several of ours bends them in equal shares.
+    for run in spine_runs:
+        _spread_rotation(canonical_global, [JOINT_INDEX[joint] for joint in run])
 
     local = np.empty_like(canonical_global)
     local[:, 0] = canonical_global[:, 0]
