@@ -172,7 +172,9 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
               for split in ("train", "val", "test")}
     sequences = {p.name: {"garment": p.garment, "body": p.body.name, "motion": p.motion.name,
                           "frames": round(config.motion_seconds * config.fps),
-                          "garment_type": p.design.garment_type, "fabric": p.design.fabric}
+                          "garment_type": p.design.garment_type, "fabric": p.design.fabric,
+                          **({"motion_file": p.motion.file, "subject": p.motion.subject}
+                             if p.motion.is_clip else {})}
                  for p in built}
     for plan in built:  # the frame count from the motion actually made
         done = next((r for r in results if r["name"] == plan.name and r["ok"]), None)

@@ -4,12 +4,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+#: Largest values a build accepts: a sequence's frames are simulated and held in memory
+#: whole (``motion_seconds · fps`` frames of the body and garment per worker).
+UPPER_LIMITS = {"fps": 240.0, "motion_seconds": 60.0, "motion_window_seconds": 60.0}
+
 
 @dataclass
 class SplitConfig:
     """How many garment designs, bodies and motions each held-out split gets. Held-out
     items never appear in training; validation and test sequences combine a held-out
-    design, body and motion (everything unseen at once)."""
+    design, body and motion (everything unseen at once).
+
+    ``val_subjects``/``test_subjects`` hold out the clips of ``motion_files`` by
+    performer (:func:`data_prep.motion_windows.clip_subject`): a held-out subject's
+    windows are motions of that split only; every other subject's are for training."""
 
     val_garments: int = 1
     test_garments: int = 2
@@ -17,6 +25,8 @@ class SplitConfig:
     test_bodies: int = 1
     val_motions: int = 1
     test_motions: int = 1
+    val_subjects: list[str] = field(default_factory=list)
+    test_subjects: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -37,6 +47,19 @@ class DataConfig:
         motions: procedural motion names (train + held out; held-out ones are the last).
         motion_seconds: length of every motion (s); fps: frames per second.
         motions_per_pair: train motions simulated per (design, body) pair.
+        motion_files: motion-capture clips (``.bvh``/``.npz`` files, or folders of
+            them) used besides the procedural ``motions``, cut into windows; relative
+            paths start at the working folder (the repository root for ``make``).
+        motion_window_seconds: length of a clip's window (s); a shorter clip is one
+            window, the whole clip. windows_per_clip: most windows cut from one clip.
+        lead_in_seconds: a clip window starts at the rest pose (the draped template)
+            and blends into its first pose over this long
+            (:func:`gnngarment.body.lead_in.with_lead_in`): mocap windows start
+            mid-motion, and a jump from the rest pose is an impulse no cloth follows.
+        hold_seconds: the body holds a window's last pose this long after it, so the
+            garment's swing after the body stops is in the data.
+        held_out_motions_per_pair: clip windows per held-out (design, body) pair, beside
+            the pair's procedural held-out motion (when the split has one).
         motion_variants: versions of every train motion (1 = the canonical one only);
             each further variant has its own seeded tempo and amplitude, and takes the
             last ``(variants - 1) / variants`` of a pair's motions.
@@ -75,6 +98,12 @@ class DataConfig:
     motion_seconds: float = 2.0
     fps: float = 30.0
     motions_per_pair: int = 1
+    motion_files: list[str] = field(default_factory=list)
+    motion_window_seconds: float = 2.0
+    windows_per_clip: int = 2
+    lead_in_seconds: float = 0.5
+    hold_seconds: float = 0.0
+    held_out_motions_per_pair: int = 1
     motion_variants: int = 1
     fabrics: list[str] = field(default_factory=lambda: ["cotton", "silk", "denim", "leather"])
     body_vertices: int = 128
@@ -98,6 +127,7 @@ class DataConfig:
         from data_prep.simulate.fabrics import FABRICS
         from gnngarment.body.anny_model import ANNY_PRESETS
         from gnngarment.body.procedural import MOTION_LIBRARY
+        from gnngarment.model.config import MAX_LEVELS
 
         for key, names, known in (("garment_types", self.garment_types, GARMENT_TYPES),
                                   ("motions", self.motions, MOTION_LIBRARY),
@@ -111,14 +141,33 @@ class DataConfig:
                 300 <= self.garment_vertices[0] <= self.garment_vertices[1]):
             raise ValueError("key 'garment_vertices': expected [low, high] with 300 <= low "
                              f"<= high, got {list(self.garment_vertices)}")
-        for key in ("fps", "motion_seconds", "drape_rest_speed"):
+        for key in ("fps", "motion_seconds", "drape_rest_speed", "motion_window_seconds"):
             value = getattr(self, key)
             if not value > 0 or value != value or value == float("inf"):
                 raise ValueError(f"key '{key}': must be a finite number > 0, got {value}")
+            if value > UPPER_LIMITS.get(key, float("inf")):
+                raise ValueError(f"key '{key}': at most {UPPER_LIMITS[key]:g}, got {value:g} "
+                                 "(docs/reliability.md, resource limits)")
+        if self.levels > MAX_LEVELS:
+            raise ValueError(f"key 'levels': the model pools at most {MAX_LEVELS} levels, got "
+                             f"{self.levels}")
         for key in ("garments", "bodies", "motions_per_pair", "motion_variants", "body_vertices",
                     "collision_points", "levels", "landmarks", "drape_frames"):
             if getattr(self, key) < 1:
                 raise ValueError(f"key '{key}': must be >= 1, got {getattr(self, key)}")
+        if self.windows_per_clip < 1 or self.held_out_motions_per_pair < 1:
+            key = "windows_per_clip" if self.windows_per_clip < 1 else "held_out_motions_per_pair"
+            raise ValueError(f"key '{key}': must be >= 1, got {getattr(self, key)}")
+        for key in ("lead_in_seconds", "hold_seconds"):
+            value = getattr(self, key)
+            if not 0 <= value <= 10:
+                raise ValueError(f"key '{key}': must be in [0, 10] seconds, got {value}")
+        subjects = set(self.splits.val_subjects) | set(self.splits.test_subjects)
+        if set(self.splits.val_subjects) & set(self.splits.test_subjects):
+            raise ValueError("key 'splits': a subject cannot be in both val_subjects and "
+                             "test_subjects")
+        if subjects and not self.motion_files:
+            raise ValueError("key 'splits': val_subjects/test_subjects need motion_files")
         if self.extra_train_garments < 0:
             raise ValueError("key 'extra_train_garments': must be >= 0, got "
                              f"{self.extra_train_garments}")

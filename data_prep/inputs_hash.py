@@ -14,7 +14,7 @@ from dataclasses import asdict
 from typing import Any
 
 from data_prep.config import DataConfig
-from data_prep.plan import BodyPlan, DesignPlan, SequencePlan
+from data_prep.plan import CLIP_FIELDS, BodyPlan, DesignPlan, SequencePlan
 
 #: Bumped when the builder's output changes for the same config (forces a rebuild).
 BUILDER_VERSION = 1
@@ -25,7 +25,8 @@ BUILDER_VERSION = 1
 PLAN_KEYS = ("seed", "garment_types", "garments", "extra_train_garments",
              "garment_vertices", "bodies",
              "body_presets", "motions", "motions_per_pair", "motion_variants", "fabrics",
-             "splits")
+             "splits", "motion_files", "motion_window_seconds", "windows_per_clip",
+             "lead_in_seconds", "hold_seconds", "held_out_motions_per_pair")
 #: Config keys that decide nothing a worker computes.
 PLACE_KEYS = ("output", "workers", "simulation", "executor", "ray_address")
 
@@ -40,10 +41,13 @@ def content_inputs(config: DataConfig, settings: Any) -> dict[str, Any]:
 
 def sequence_inputs_hash(inputs: dict[str, Any], plan: SequencePlan) -> str:
     """The hash a built sequence is recorded with (its ``.hash`` file). A canonical
-    motion (tempo and amplitude 1) is hashed without those two fields."""
+    motion (tempo and amplitude 1) is hashed without those two fields, a procedural one
+    without the clip fields (so hashes of builds before clips existed still hold); a
+    clip's window, lead-in, hold and file digest are in its plan."""
     fields = asdict(plan)
     fields["motion"] = {key: value for key, value in fields["motion"].items()
-                        if key not in ("speed", "amplitude") or value != 1.0}
+                        if not (key in ("speed", "amplitude") and value == 1.0)
+                        and not (key in CLIP_FIELDS and not fields["motion"]["file"])}
     return _hash({**inputs, "plan": fields})
 
 

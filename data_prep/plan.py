@@ -7,6 +7,7 @@ sequence combines a held-out design, body and motion of the same split.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -34,7 +35,10 @@ class DesignPlan:
 @dataclass(frozen=True)
 class MotionPlan:
     """One motion of the build: a library motion, its seed and, for a variant, its
-    tempo (``speed``) and joint-angle (``amplitude``) multipliers."""
+    tempo (``speed``) and joint-angle (``amplitude``) multipliers; or (``motion ==
+    "clip"``) a window of a motion-capture clip: ``seconds`` of ``file`` from ``start``,
+    led in from the rest pose over ``lead_in`` seconds and its last pose held ``hold``
+    seconds (:func:`planned_motion`)."""
 
     name: str
     motion: str
@@ -42,6 +46,23 @@ class MotionPlan:
     split: str
     speed: float = 1.0
     amplitude: float = 1.0
+    file: str = ""
+    subject: str = ""
+    start: float = 0.0
+    seconds: float = 0.0
+    digest: str = ""
+    lead_in: float = 0.0
+    hold: float = 0.0
+
+    @property
+    def is_clip(self) -> bool:
+        return self.motion == CLIP_MOTION
+
+
+#: ``MotionPlan.motion`` of a motion-capture window.
+CLIP_MOTION = "clip"
+#: The fields only a clip window sets (left out of a procedural motion's hash).
+CLIP_FIELDS = ("file", "subject", "start", "seconds", "digest", "lead_in", "hold")
 
 
 @dataclass(frozen=True)
@@ -95,7 +116,11 @@ def plan_dataset(config: DataConfig) -> list[SequencePlan]:
     motion_split = _assign(len(config.motions), splits.val_motions, splits.test_motions)
     motions = [MotionPlan(f"{name}{k:02d}", name, int(rng.integers(1 << 30)), motion_split[k])
                for k, name in enumerate(config.motions)]
+    clips = _clip_motions(config)
     train_motions = [m for m in motions if m.split == "train"]
+    train_clips = [m for m in clips if m.split == "train"]
+    held_out_clips = {split: [m for m in clips if m.split == split] for split in ("val", "test")}
+    next_clip = {"train": 0, "val": 0, "test": 0}
     designs += _extra_train_designs(config)
 
     sequences = []
@@ -106,16 +131,28 @@ def plan_dataset(config: DataConfig) -> list[SequencePlan]:
                     # The first motions of a pair are the canonical ones (so adding
                     # variants to a config keeps every sequence it already had).
                     motion = train_motions[(b + j + designs.index(design)) % len(train_motions)]
+                    if train_clips and j > 0:
+                        # With clips, a pair's first motion is procedural (as before) and
+                        # the others are clip windows in turn, round-robin over subjects,
+                        # so every training window is used about equally often.
+                        motion = train_clips[next_clip["train"] % len(train_clips)]
+                        next_clip["train"] += 1
                     variant = j * config.motion_variants // config.motions_per_pair
-                    if variant:
+                    if variant and not motion.is_clip:  # a clip is played as recorded
                         motion = _motion_variant(motion, variant, (config.seed, design.seed, b))
                     sequences.append(SequencePlan(f"{design.name}_{body.name}_{motion.name}",
                                                   design, body, motion, "train"))
             elif design.split != "train" and body.split == design.split:
                 held_out = [m for m in motions if m.split == design.split]
-                motion = held_out[designs.index(design) % len(held_out)]
-                sequences.append(SequencePlan(f"{design.name}_{body.name}_{motion.name}",
-                                              design, body, motion, design.split))
+                chosen = [held_out[designs.index(design) % len(held_out)]] if held_out else []
+                # Clip windows in turn, round-robin over subjects: each pair gets its own.
+                windows = held_out_clips[design.split]
+                for _ in range(min(config.held_out_motions_per_pair, len(windows))):
+                    chosen.append(windows[next_clip[design.split] % len(windows)])
+                    next_clip[design.split] += 1
+                for motion in chosen:
+                    sequences.append(SequencePlan(f"{design.name}_{body.name}_{motion.name}",
+                                                  design, body, motion, design.split))
     repeated = len(sequences) - len({plan.name for plan in sequences})
     if repeated:
         raise ValueError(
@@ -123,6 +160,36 @@ def plan_dataset(config: DataConfig) -> list[SequencePlan]:
             f"motion ({repeated} sequences planned twice); there are {len(train_motions)} "
             f"train motions, each in {config.motion_variants} variant(s)")
     return sequences
+
+
+def _clip_motions(config: DataConfig) -> list[MotionPlan]:
+    """The windows of the config's motion files as motions, split by subject, each split
+    ordered round-robin over its subjects (the first pairs see them all)."""
+    from data_prep.motion_windows import clip_windows, find_clips, interleave_by_subject
+
+    if not config.motion_files:
+        return []
+    windows = clip_windows(find_clips(config.motion_files), config.motion_window_seconds,
+                           config.windows_per_clip, config.seed)
+    split_of = {**{s: "val" for s in config.splits.val_subjects},
+                **{s: "test" for s in config.splits.test_subjects}}
+    found = {w.subject for w in windows}
+    unknown = sorted(set(split_of) - found)
+    if unknown:
+        raise ValueError(f"key 'splits': subjects {unknown} have no clip in motion_files "
+                         f"(subjects there: {', '.join(sorted(found))})")
+    motions = []
+    for split in ("train", "val", "test"):
+        chosen = interleave_by_subject(
+            [w for w in windows if split_of.get(w.subject, "train") == split])
+        motions += [MotionPlan(w.name, CLIP_MOTION, 0, split, file=w.file, subject=w.subject,
+                               start=w.start, seconds=w.seconds, digest=w.digest,
+                               lead_in=config.lead_in_seconds, hold=config.hold_seconds)
+                    for w in chosen]
+    if not any(m.split == "train" for m in motions):
+        raise ValueError("key 'splits': every subject of motion_files is held out; leave "
+                         "some for training")
+    return motions
 
 
 def _extra_train_designs(config: DataConfig) -> list[DesignPlan]:
@@ -158,11 +225,42 @@ def _motion_variant(motion: MotionPlan, variant: int, key: tuple[int, ...]) -> M
                       amplitude=round(float(rng.uniform(*VARIANT_AMPLITUDE)), 3))
 
 
-def planned_motion(plan: MotionPlan, config: DataConfig):
+def planned_motion(plan: MotionPlan, config: DataConfig, body_model=None, shape=None):
     """The :class:`~gnngarment.body.motion.Motion` a plan stands for (``config`` gives its
-    length and frame rate)."""
-    from gnngarment.body.procedural import make_motion
+    length and frame rate).
 
-    return make_motion(plan.motion, duration=config.motion_seconds, fps=config.fps,
-                       speed=plan.speed, amplitude=plan.amplitude, seed=plan.seed)
+    A clip window is read and retargeted onto the body it plays on (``body_model`` in
+    ``shape``: a BVH's rest pose and units depend on it), its T-pose reference start
+    dropped (:func:`~gnngarment.body.lead_in.trim_reference_pose`), resampled to
+    ``config.fps``, cut
+    to its window with the root translation made relative to the window's first frame,
+    led in from the rest pose and its last pose held (``plan.lead_in``, ``plan.hold``).
+    """
+    if not plan.is_clip:
+        from gnngarment.body.procedural import make_motion
+
+        return make_motion(plan.motion, duration=config.motion_seconds, fps=config.fps,
+                           speed=plan.speed, amplitude=plan.amplitude, seed=plan.seed)
+    from gnngarment.body.bvh_motion import UnmappedJointsWarning
+    from gnngarment.body.lead_in import trim_reference_pose, with_lead_in
+    from gnngarment.body.motion import Motion
+    from gnngarment.body.motion_io import load_motion_for_body
+
+    if body_model is None:
+        raise ValueError(f"{plan.name}: a clip window needs the body it plays on")
+    # A file's T-pose reference frame (smeared into its first pose) is not motion: it is
+    # dropped at the file's own rate, before resampling blurs it further.
+    with warnings.catch_warnings():  # unmapped fingers and eyes: said once by `inspect`
+        warnings.simplefilter("ignore", UnmappedJointsWarning)
+        clip = trim_reference_pose(load_motion_for_body(plan.file, body_model, shape))
+    clip = clip.resample(config.fps)
+    first = min(round(plan.start * config.fps), len(clip) - 1)
+    window = clip[first:first + round(plan.seconds * config.fps) + 1]
+    window = Motion(window.rotations, window.translation - window.translation[:1],
+                    config.fps, plan.name)
+    if plan.hold > 0:
+        held = window[-1:]
+        window = Motion.concatenate([window] + [held] * round(plan.hold * config.fps),
+                                    name=plan.name)
+    return with_lead_in(window, plan.lead_in)
 

@@ -59,9 +59,10 @@ def synthetic_body_meshes(root: str | Path) -> Callable[[str], BodyMesh | None]:
         if "model" not in state:
             state["model"] = AnnyBodyModel()
         model = state["model"]
-        motion = planned_motion(plan.motion, config)
+        shape = AnnyShape(**plan.body.shape)
+        motion = planned_motion(plan.motion, config, model, shape)
         with torch.no_grad():
-            vertices = model.pose(motion, AnnyShape(**plan.body.shape)).vertices.numpy()
+            vertices = model.pose(motion, shape).vertices.numpy()
         stored = read_sequence(root, name).body_points
         samples = model.feature_vertex_indices(config.collision_points)
         if (stored.shape != (len(vertices), len(samples), 3)

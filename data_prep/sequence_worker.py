@@ -39,7 +39,7 @@ def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[s
 
         body_model = anny_body_model()
         shape = anny_shape(plan.body)
-        motion = planned_motion(plan.motion, config)
+        motion = planned_motion(plan.motion, config, body_model, shape)
         with torch.no_grad():
             posed = body_model.pose(motion, shape)
         body_vertices = posed.vertices.numpy()

@@ -7,7 +7,8 @@ Public API (shapes in each docstring):
 * motions: :class:`Motion`, :class:`MotionError`, :func:`make_motion`,
   :func:`list_motions`, :func:`load_motion`, :func:`load_motion_for_body`,
   :func:`load_amass_motion`, :func:`load_bvh_motion`, :func:`load_cloth3d_motion`,
-  :func:`motion_from_smpl`;
+  :func:`motion_from_smpl`, :func:`with_lead_in`, :func:`lead_in_frames`,
+  :func:`trim_reference_pose`;
 * body models: :class:`BodyModel`, :class:`RestBody`, :class:`PosedBody`,
   :class:`AnnyBodyModel`, :class:`AnnyShape`, :data:`ANNY_PRESETS`,
   :func:`sample_anny_shapes`, :class:`SMPLBodyModel`, :func:`create_body_model`;
@@ -41,6 +42,12 @@ from gnngarment.body.features import (
     velocity_windows,
     vertex_velocities,
 )
+from gnngarment.body.lead_in import (
+    MAX_LEAD_IN_SECONDS,
+    lead_in_frames,
+    trim_reference_pose,
+    with_lead_in,
+)
 from gnngarment.body.motion import Motion, MotionError
 from gnngarment.body.motion_io import load_motion, load_motion_for_body
 from gnngarment.body.procedural import MOTION_LIBRARY, list_motions, make_motion
@@ -61,6 +68,7 @@ __all__ = [
     "ANNY_SHAPE_RANGES",
     "JOINT_NAMES",
     "JOINT_PARENTS",
+    "MAX_LEAD_IN_SECONDS",
     "MOTION_LIBRARY",
     "NUM_JOINTS",
     "AnnyBodyModel",
@@ -77,6 +85,7 @@ __all__ = [
     "farthest_point_sampling",
     "forward_kinematics",
     "joint_vertex_distances",
+    "lead_in_frames",
     "list_motions",
     "load_amass_motion",
     "load_anny",
@@ -93,6 +102,8 @@ __all__ = [
     "sample_anny_shapes",
     "skin",
     "sliding_windows",
+    "trim_reference_pose",
     "velocity_windows",
     "vertex_velocities",
+    "with_lead_in",
 ]

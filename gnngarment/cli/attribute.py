@@ -28,7 +28,8 @@ def attribute_command(
     motion: Annotated[str, typer.Option(
         "--motion", help="Procedural motion name or .npz/.bvh/.mat file.")] = "walk",
     frame: Annotated[int | None, typer.Option(
-        "--frame", help="Frame of the motion (default: the middle one).")] = None,
+        "--frame", help="Frame of the motion, its lead-in included, as animate exports "
+        "it (default: the middle one).")] = None,
     target: Annotated[str, typer.Option(
         "--target", help="vertex, region or all.")] = "vertex",
     vertex: Annotated[list[int] | None, typer.Option(
@@ -58,6 +59,10 @@ def attribute_command(
         "BVH's (docs/motions.md).")] = None,
     motion_up_axis: Annotated[str, typer.Option(
         "--motion-up-axis", help="Up axis of a .npz/.bvh motion: auto, y or z.")] = "auto",
+    lead_in: Annotated[float | None, typer.Option(
+        "--lead-in", help="Seconds of a blend from the rest pose into the motion, in front "
+        "of it, as animate --lead-in (default: 0.5 for a motion file, 0 for a procedural "
+        "motion).")] = None,
     source_body: Annotated[Path | None, typer.Option(
         "--source-body", help="The body mesh the garment was modelled on: the garment is "
         "fitted from it onto the rest body first (as animate --source-body).")] = None,
@@ -93,6 +98,14 @@ def attribute_command(
     if body_model not in ("anny", "smpl"):
         raise fail(f"--body-model must be 'anny' or 'smpl', got '{body_model}'")
     check_motion_options(fps, duration, motion_up_axis)
+    from gnngarment.body.lead_in import MAX_LEAD_IN_SECONDS, check_lead_in_seconds
+    from gnngarment.body.motion_io import default_lead_in
+
+    try:
+        lead_in = default_lead_in(motion) if lead_in is None else check_lead_in_seconds(lead_in)
+    except MotionError:
+        raise fail(f"--lead-in must be a finite number of seconds in "
+                   f"[0, {MAX_LEAD_IN_SECONDS:g}], got {lead_in}") from None
     from gnngarment.inference.output_folder import check_output_folder
 
     try:  # now, not when the results are written after the integrated gradients
@@ -116,7 +129,7 @@ def attribute_command(
             shape_inputs = body_shape_inputs(body, body_shape, count)
             frames = body_motion_inputs(body, body_shape, load_motion_for_body(
                 motion, body, body_shape, fps=fps, joint_map=joint_map,
-                up_axis=motion_up_axis, duration=duration), count)
+                up_axis=motion_up_axis, lead_in=lead_in, duration=duration), count)
     except (MotionError, SMPLModelError, ValueError) as error:
         raise fail(str(error)) from None
     if source is not None:

@@ -410,9 +410,11 @@ def _collision_settings():
 
 
 def _load_body_and_motion(body_shape: str, motion: str, fps: float, duration: float,
-                          joint_map: Path | None = None, motion_up_axis: str = "auto"):
+                          joint_map: Path | None = None, motion_up_axis: str = "auto",
+                          lead_in: float = 0.0):
     """Anny body, its shape and a motion (procedural name or file, retargeted onto this
-    shape's rest skeleton), or a clear failure."""
+    shape's rest skeleton, after ``lead_in`` seconds from the rest pose), or a clear
+    failure."""
     from gnngarment.body import AnnyBodyModel, MotionError, load_motion_for_body
 
     body_model = AnnyBodyModel()
@@ -423,7 +425,7 @@ def _load_body_and_motion(body_shape: str, motion: str, fps: float, duration: fl
     try:
         motion_value = load_motion_for_body(motion, body_model, shape, fps=fps,
                                             joint_map=joint_map, up_axis=motion_up_axis,
-                                            duration=duration)
+                                            lead_in=lead_in, duration=duration)
     except (MotionError, ValueError, OSError) as error:
         raise fail(f"--motion {motion}: {error}") from None
     return body_model, shape, motion_value
@@ -477,6 +479,43 @@ def _check_animate_options(fps: float, duration: float, motion_up_axis: str,
         raise fail(f"--offset must be 3 finite numbers (metres), got {list(offset)}")
     if not 1 <= influences <= 8:  # the range of the glb writer's static skin
         raise fail(f"--influences must be in 1..8, got {influences}")
+
+
+#: ``--lead-in``'s help; the seconds themselves: :func:`_lead_in_seconds`.
+LEAD_IN_HELP = (
+    "Seconds of a smooth blend from the rest pose (the garment's draped pose) into the "
+    "motion's first pose, in front of it; a file's T-pose reference frame is dropped "
+    "first. Default: 0.5 for a motion file, 0 for a procedural motion (they start at "
+    "rest). The exports include these frames: the first round(seconds * fps) frames are "
+    "the lead-in, the clip starts after them; 0 exports the clip as loaded "
+    "(docs/motions.md).")
+
+
+def _lead_in_seconds(motion: str, lead_in: float | None) -> float:
+    """``--lead-in``, checked before any loading, or its default for ``motion``
+    (:func:`~gnngarment.body.motion_io.default_lead_in`)."""
+    from gnngarment.body.lead_in import MAX_LEAD_IN_SECONDS, check_lead_in_seconds
+    from gnngarment.body.motion import MotionError
+    from gnngarment.body.motion_io import default_lead_in
+
+    if lead_in is None:
+        return default_lead_in(motion)
+    try:
+        return check_lead_in_seconds(lead_in)
+    except MotionError:
+        raise fail(f"--lead-in must be a finite number of seconds in "
+                   f"[0, {MAX_LEAD_IN_SECONDS:g}], got {lead_in}") from None
+
+
+def _lead_in_note(seconds: float, fps: float) -> str:
+    """Which of the animated frames are the lead-in, for the summary line."""
+    from gnngarment.body.lead_in import lead_in_frames
+
+    count = lead_in_frames(seconds, fps)
+    if count == 0:
+        return ""
+    return (f"; frames 0-{count - 1} are the {seconds:g} s lead-in from the rest pose, "
+            f"the motion starts at frame {count}")
 
 
 def _drape(placed, faces, body_inputs, garment_mesh: Path):
@@ -543,6 +582,7 @@ def animate(
     resolve_collisions: Annotated[bool, typer.Option(
         help="Move garment vertices out of the body (closer than epsilon, "
              "configs/collisions.yaml), the rest garment and every frame.")] = True,
+    lead_in: Annotated[float | None, typer.Option(help=LEAD_IN_HELP)] = None,
 ) -> None:
     """Animate a garment mesh on a body and motion; write OBJ/PC2/glb/GIF."""
     from tqdm import tqdm
@@ -559,6 +599,7 @@ def animate(
     format_list = [f.strip() for f in formats.split(",")]
     _check_animate_options(fps, duration, motion_up_axis, format_list, fix_units, up_axis,
                            scale, offset, influences)
+    lead_in_seconds = _lead_in_seconds(motion, lead_in)
     checkpoint = checkpoint or SHIPPED_MODEL
     use_idle_cores()
     try:
@@ -568,7 +609,8 @@ def animate(
     except (MeshError, ValueError) as error:
         raise fail(str(error)) from None
     body_model, shape, motion_value = _load_body_and_motion(body_shape, motion, fps, duration,
-                                                            joint_map, motion_up_axis)
+                                                            joint_map, motion_up_axis,
+                                                            lead_in_seconds)
     body_inputs = body_shape_inputs(body_model, shape, model.config.body_vertices)
     try:
         placed = place_garment(pos, faces, body_inputs, units=fix_units, up_axis=up_axis,
@@ -633,7 +675,8 @@ def animate(
                       f"(largest push {1000 * stats.max_push.max():.1f} mm, "
                       f"{seconds['collisions']:.2f} s)")
     console.print(f"[green]animated[/] {len(motion_value)} frames "
-                  f"(context {seconds['context']:.2f} s, frames {seconds['frames']:.2f} s); wrote:")
+                  f"(context {seconds['context']:.2f} s, frames {seconds['frames']:.2f} s)"
+                  f"{_lead_in_note(lead_in_seconds, fps)}; wrote:")
     for key, path in paths.items():
         console.print(f"  {key}: {path}")
 
