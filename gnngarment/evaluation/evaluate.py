@@ -62,8 +62,9 @@ class EvaluationReport:
     def to_markdown(self) -> str:
         """Table in the layout of the blueprint's Table 1: one row per method, one group
         of columns per garment type."""
-        types = sorted({t for per_type in self.results.values() for t in per_type} - {"all"})
-        types.append("all")
+        groups = {t for per_type in self.results.values() for t in per_type} - {"all"}
+        sources = sorted(groups & {CLIP_MOTIONS, PROCEDURAL_MOTIONS})
+        types = sorted(groups - set(sources)) + sources + ["all"]
         header = ["method"] + [f"{t} {m}" for t in types for m in ("E_verts mm", "E_norm °")]
         lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
         for method, per_type in self.results.items():
@@ -198,11 +199,27 @@ def spurious_change(model: GarmentDeformer | None, dataset: PreparedDataset, nam
     return 1000 * float(np.linalg.norm(perturbed - baseline, axis=-1).mean())
 
 
+#: Groups of sequences by where their motion came from, reported beside the garment
+#: types when a split holds both (a build with ``motion_files``, docs/data.md).
+CLIP_MOTIONS, PROCEDURAL_MOTIONS = "clip motions", "procedural motions"
+
+
+def motion_sources(dataset: PreparedDataset) -> dict[str, str]:
+    """Sequence → :data:`CLIP_MOTIONS` (a motion-capture window: the manifest names its
+    file) or :data:`PROCEDURAL_MOTIONS`."""
+    return {name: CLIP_MOTIONS if "motion_file" in dataset.manifest["sequences"][name]
+            else PROCEDURAL_MOTIONS for name in dataset.sequence_names}
+
+
 def _aggregate(per_sequence: dict[str, dict[str, float]], types: dict[str, str],
-               frames: dict[str, int]) -> dict[str, dict[str, float]]:
+               frames: dict[str, int], sources: dict[str, str] | None = None
+               ) -> dict[str, dict[str, float]]:
     grouped: dict[str, list[str]] = {}
     for name in per_sequence:
         grouped.setdefault(types[name], []).append(name)
+    if sources and len({sources[n] for n in per_sequence}) > 1:
+        for name in per_sequence:
+            grouped.setdefault(sources[name], []).append(name)
     grouped["all"] = list(per_sequence)
     result = {}
     for garment_type, names in grouped.items():
@@ -282,7 +299,8 @@ def evaluate(models: dict[str, GarmentDeformer], dataset: PreparedDataset,
     for method, per_sequence in methods.items():
         if per_sequence:
             report.sequences[method] = per_sequence
-            report.results[method] = _aggregate(per_sequence, types, frames)
+            report.results[method] = _aggregate(per_sequence, types, frames,
+                                                motion_sources(dataset))
     return report
 
 
