@@ -11,7 +11,7 @@ from gnngarment.attribution.errors import AttributionArgumentError
 from gnngarment.body.skeleton import NUM_JOINTS
 from gnngarment.data.body_inputs import BodyMotionInputs
 from gnngarment.model.config import ModelConfig
-from gnngarment.model.deformer import MOTION_CHANNELS
+from gnngarment.model.deformer import MOTION_CHANNELS, DeformerContext, GarmentDeformer
 
 
 @dataclass
@@ -23,11 +23,30 @@ class FrameInputs:
         motion_window: ``(1, 1, m, 75)`` joint axis-angles + root displacement.
         velocity_window: ``(1, 1, m, 3 N_b')`` body-subset velocities (m/s).
         joint_transforms: ``(1, 1, 24, 4, 4)`` skinning transforms of the frame.
+        history_transforms: ``(T, 24, 4, 4)`` the transforms of every frame up to and
+            including this one (a model with dynamics carries its oscillators over
+            them), or ``None``: the frame as if the body had held it (no history).
+        fps: frames per second of that history.
     """
 
     motion_window: torch.Tensor
     velocity_window: torch.Tensor
     joint_transforms: torch.Tensor
+    history_transforms: torch.Tensor | None = None
+    fps: float = 30.0
+
+    def dynamic_offsets(self, model: GarmentDeformer, context: DeformerContext
+                        ) -> torch.Tensor | None:
+        """The oscillators' blend shapes ``(ΣN, 3)`` at this frame for every pair of
+        ``context`` (they depend on its features, so an attribution recomputes them per
+        interpolation step), or ``None`` for a model without dynamics."""
+        if not model.has_dynamics:
+            return None
+        history = (self.joint_transforms[0] if self.history_transforms is None
+                   else self.history_transforms)
+        pairs = context.num_pairs
+        frames = torch.full((pairs, 1), history.shape[0] - 1, dtype=torch.long)
+        return model.dynamic_blend_shapes(context, [history] * pairs, frames, self.fps)
 
     @classmethod
     def rest(cls, config: ModelConfig) -> FrameInputs:
@@ -67,7 +86,10 @@ class FrameInputs:
             velocity_window=torch.from_numpy(np.ascontiguousarray(
                 velocity[rows], dtype=np.float32))[None, None],
             joint_transforms=torch.from_numpy(np.ascontiguousarray(
-                frames.joint_transforms[index], dtype=np.float32))[None, None])
+                frames.joint_transforms[index], dtype=np.float32))[None, None],
+            history_transforms=torch.from_numpy(np.ascontiguousarray(
+                frames.joint_transforms[:index + 1], dtype=np.float32)),
+            fps=float(frames.fps))
 
     @classmethod
     def coerce(cls, value: FrameInputs | tuple[torch.Tensor, torch.Tensor, torch.Tensor],
@@ -117,8 +139,9 @@ class FrameInputs:
         def copy(tensor: torch.Tensor) -> torch.Tensor:
             return tensor.detach().to(device=device, dtype=torch.float32).clone()
 
+        history = None if self.history_transforms is None else copy(self.history_transforms)
         return FrameInputs(copy(self.motion_window), copy(self.velocity_window),
-                           copy(self.joint_transforms))
+                           copy(self.joint_transforms), history, self.fps)
 
 
 def _batched(tensor: torch.Tensor, item_dims: int) -> torch.Tensor:

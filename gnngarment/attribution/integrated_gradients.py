@@ -65,7 +65,8 @@ class FeatureResponse:
         frame = self.frame
         out = self.model(context, frame.motion_window.expand(copies, -1, -1, -1),
                          frame.velocity_window.expand(copies, -1, -1, -1),
-                         frame.joint_transforms.expand(copies, -1, -1, -1, -1))
+                         frame.joint_transforms.expand(copies, -1, -1, -1, -1),
+                         frame.dynamic_offsets(self.model, context))
         if self.output == "blend_shapes":
             values = out.blend_shapes.view(copies, n, 3)
         else:

@@ -25,7 +25,7 @@ def largest_output_vertex(model: GarmentDeformer, pair: GarmentBodyPair, frame: 
             frame = frame.to(device)
             context = model.encode([pair])
             out = model(context, frame.motion_window, frame.velocity_window,
-                        frame.joint_transforms)
+                        frame.joint_transforms, frame.dynamic_offsets(model, context))
             values = (out.blend_shapes if output == "blend_shapes"
                       else out.posed - pair.rest_pos.to(device))
     finally:

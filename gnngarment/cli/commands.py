@@ -331,7 +331,10 @@ def train(
         raise fail(str(error)) from None
     if len(validation) == 0:
         validation = None
-    trainer = Trainer(settings, train_split, validation)
+    try:
+        trainer = Trainer(settings, train_split, validation)
+    except ValueError as error:   # initial_weights that do not fit, a cache for another model
+        raise fail(str(error)) from None
     try:
         summary = trainer.fit(resume=resume)
     except (CacheError, RunFolderError, FloatingPointError) as error:

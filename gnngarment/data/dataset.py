@@ -51,6 +51,9 @@ class TrainingBatch:
         body_item: ``(M_V,)`` their item.
         garment_types: ``P`` type names; sequences: ``P`` sequence names;
         frames: ``(P, B)`` frame indices.
+        sequence_transforms: ``P`` tensors ``(T_p, 24, 4, 4)``, every frame of each
+            sequence (the oscillators' drive needs the history before the frames).
+        fps: frames per second of the sequences (one value for the batch).
     """
 
     pairs: list[GarmentBodyPair]
@@ -71,6 +74,8 @@ class TrainingBatch:
     garment_types: list[str]
     sequences: list[str]
     frames: np.ndarray
+    sequence_transforms: list[torch.Tensor] | None = None
+    fps: float = 30.0
 
     @property
     def num_frames(self) -> int:
@@ -92,6 +97,13 @@ def window_indices(frames: np.ndarray, window: int) -> np.ndarray:
     """``(len(frames), window)`` indices of the last ``window`` frames before each frame,
     oldest first; indices before 0 repeat frame 0 (the padding rule of the body layer)."""
     return np.clip(np.asarray(frames)[:, None] + np.arange(-window + 1, 1)[None, :], 0, None)
+
+
+def _one_rate(rates: set[float], names: list[str]) -> float:
+    if len(rates) != 1:
+        raise ValueError(f"sequences {names} have different frame rates {sorted(rates)}; "
+                         "a batch needs one")
+    return rates.pop()
 
 
 class PreparedDataset:
@@ -192,6 +204,7 @@ class PreparedDataset:
         pairs, motion, velocity, transforms = [], [], [], []
         target, rest, faces, edges, inverse, area, mass, item = [], [], [], [], [], [], [], []
         body_points, body_normals, body_item, types = [], [], [], []
+        whole, rates = [], set()
         offset, k = 0, 0
         for name, frames in items:
             record = self.sequence(name)
@@ -207,6 +220,8 @@ class PreparedDataset:
             velocity.append(torch.from_numpy(
                 record.velocities[windows].reshape(len(frames), self.window, -1)))
             transforms.append(torch.from_numpy(record.joint_transforms[frames]))
+            whole.append(torch.from_numpy(record.joint_transforms))
+            rates.add(float(record.fps))
             n = garment.pair.rest_pos.shape[0]
             for frame in frames:
                 target.append(torch.from_numpy(record.positions[frame]))
@@ -232,7 +247,8 @@ class PreparedDataset:
             body_points=torch.cat(body_points), body_normals=torch.cat(body_normals),
             body_item=torch.cat(body_item), garment_types=types,
             sequences=[name for name, _ in items],
-            frames=np.stack([np.asarray(f) for _, f in items]))
+            frames=np.stack([np.asarray(f) for _, f in items]),
+            sequence_transforms=whole, fps=_one_rate(rates, [name for name, _ in items]))
 
     def epoch_items(self, frames_per_item: int, rng: np.random.Generator
                     ) -> list[tuple[str, np.ndarray]]:

@@ -106,11 +106,13 @@ def predict(model: GarmentDeformer, dataset: PreparedDataset, name: str,
                                   else joint_transforms)
     velocity = torch.from_numpy(record.velocities.reshape(record.num_frames, -1))
     out, weights = [], []
+    stream = model.dynamics_stream(context, record.fps) if model.has_dynamics else None
     for start in range(0, record.num_frames, chunk):
         frames = np.arange(start, min(start + chunk, record.num_frames))
         windows = torch.from_numpy(window_indices(frames, model.config.window))
+        offsets = None if stream is None else stream.advance(transforms[frames]).flatten(0, 1)
         result = model(context, features[windows][None], velocity[windows][None],
-                       transforms[frames][None])
+                       transforms[frames][None], offsets)
         out.append(result.posed.view(len(frames), -1, 3))
         if return_weights:
             weights.append(result.weights.view(len(frames), -1, result.weights.shape[-1]))

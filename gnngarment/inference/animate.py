@@ -182,12 +182,15 @@ def animate(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray, body: Bo
     velocity = torch.from_numpy(frames.velocities.reshape(total, -1))
     transforms = torch.from_numpy(frames.joint_transforms)
     posed, weights, blend = [], [], []
+    # The oscillators' state runs through the chunks: the same result as one pass.
+    stream = model.dynamics_stream(context, frames.fps) if model.has_dynamics else None
     started = time.perf_counter()
     for start in range(0, total, chunk):
         index = np.arange(start, min(start + chunk, total))
         windows = torch.from_numpy(window_indices(index, window))
+        offsets = None if stream is None else stream.advance(transforms[index]).flatten(0, 1)
         out = model(context, motion[windows][None], velocity[windows][None],
-                    transforms[index][None])
+                    transforms[index][None], offsets)
         count = len(index)
         posed.append(out.posed.view(count, -1, 3))
         weights.append(out.weights.view(count, -1, 24))

@@ -18,6 +18,9 @@ ATTENTION_IMPLEMENTATIONS = ("csr", "pyg")
 #: paper's head, a plain softmax of the learned logits.
 WEIGHT_PRIORS = ("body", "none")
 
+#: Most oscillator modes per vertex (``dynamics_modes``).
+MAX_DYNAMICS_MODES = 8
+
 #: Most pooling levels of the multilevel processor (and of a garment's hierarchy that a
 #: model can use); a small garment stops shrinking well before this.
 MAX_LEVELS = 6
@@ -69,6 +72,11 @@ class ModelConfig:
             either. Without the ``body`` prior and a ``weight_reach`` there is no reach
             and it is ignored. ``False`` (what checkpoints saved before it existed load
             as) shows every joint.
+        dynamics_modes: ``K`` driven, damped oscillator modes per vertex added to the
+            blend shapes (:mod:`gnngarment.model.oscillator`): the garment keeps moving
+            after the body stops. Their drive is the acceleration of each vertex's
+            body-skinning frame, so it needs the ``body`` prior's transferred weights.
+            0 (what checkpoints saved before it existed load as): none.
     """
 
     garment_channels: list[int] = field(default_factory=lambda: [32, 64, 128, 128])
@@ -91,6 +99,7 @@ class ModelConfig:
     weight_prior: str = "body"
     weight_reach: float | None = 0.2
     motion_reach: bool = True
+    dynamics_modes: int = 0
 
     def __post_init__(self) -> None:
         # Checked on construction, like every other config dataclass: an inconsistent
@@ -133,6 +142,12 @@ class ModelConfig:
             raise ValueError(f"levels must be in 0..{MAX_LEVELS}, got {self.levels}")
         if not 0 < self.pooling_ratio < 1:
             raise ValueError(f"pooling_ratio must be in (0, 1), got {self.pooling_ratio}")
+        if not 0 <= self.dynamics_modes <= MAX_DYNAMICS_MODES:
+            raise ValueError(f"dynamics_modes must be in 0..{MAX_DYNAMICS_MODES}, "
+                             f"got {self.dynamics_modes}")
+        if self.dynamics_modes and self.weight_prior != "body":
+            raise ValueError("dynamics_modes needs weight_prior 'body' (the oscillators are "
+                             "driven by the body-skinning frame of every vertex)")
         for name in ("motion_layers", "processor_channels", "processor_heads", "output_heads",
                      "landmarks", "body_vertices", "window"):
             if getattr(self, name) < 1:

@@ -26,6 +26,13 @@ from gnngarment.model.garment_encoder import GarmentGraphEncoder
 from gnngarment.model.graph_levels import GraphLevels, repeated_level_graph, stack_hierarchies
 from gnngarment.model.motion_encoder import MotionEncoder
 from gnngarment.model.multilevel_processor import MultilevelProcessor
+from gnngarment.model.oscillator import (
+    OscillatorHead,
+    OscillatorParameters,
+    OscillatorState,
+    oscillator_drive,
+    oscillator_response,
+)
 from gnngarment.model.skinning_weight_head import SkinningWeightHead, body_prior_logits
 from gnngarment.model.style_encoder import StyleEncoder
 
@@ -58,6 +65,8 @@ class DeformerContext:
         motion_mask: ``(P, 75)`` and velocity_mask ``(P, 3 N_b')``, 1 where a pair's
             motion encoders see the input and 0 where ``motion_reach`` hides it
             (:func:`motion_input_masks`), or ``None`` when they see everything.
+        body_weights: ``(ΣN, 24)`` the pairs' transferred body skinning weights (the
+            oscillators' drive frame), or ``None`` when the pairs have none.
     """
 
     fused: torch.Tensor
@@ -68,6 +77,7 @@ class DeformerContext:
     active_channels: torch.Tensor | None = None
     motion_mask: torch.Tensor | None = None
     velocity_mask: torch.Tensor | None = None
+    body_weights: torch.Tensor | None = None
     _graphs: dict[int, GraphLevels] = field(default_factory=dict, repr=False)
 
     @property
@@ -84,6 +94,8 @@ class DeformerOutput:
         weights: ``(V, 24)`` skinning weights ``W^t`` (rows sum to 1).
         blend_shapes: ``(V, 3)`` ``B^t`` (metres, rest frame).
         supervised_blend_shapes: ``(V, 3)`` the supervised submodule's part of ``B^t``.
+        dynamic_blend_shapes: ``(V, 3)`` the oscillators' part of ``B^t`` (the offsets
+            passed to :meth:`GarmentDeformer.forward`), or ``None`` without dynamics.
         posed: ``(V, 3)`` ``M^t`` (metres, world).
         item: ``(V,)`` item index of every vertex.
         item_ptr: ``(P·B + 1,)`` vertex offsets of the items.
@@ -95,6 +107,14 @@ class DeformerOutput:
     posed: torch.Tensor
     item: torch.Tensor
     item_ptr: torch.Tensor
+    dynamic_blend_shapes: torch.Tensor | None = None
+
+    @property
+    def static_blend_shapes(self) -> torch.Tensor:
+        """``(V, 3)`` the blend shapes of the submodules alone (without the oscillators)."""
+        if self.dynamic_blend_shapes is None:
+            return self.blend_shapes
+        return self.blend_shapes - self.dynamic_blend_shapes
 
     def split(self, name: str, pair_sizes: Sequence[int], frames: int) -> list[torch.Tensor]:
         """One ``(B, N_p, C)`` tensor per pair for the output field ``name``."""
@@ -148,6 +168,10 @@ class GarmentDeformer(nn.Module):
             # exactly zero until trained (output weights zero, inner layers as usual).
             nn.init.zeros_(self.physics_processor.output.lin.weight)
             nn.init.zeros_(self.physics_processor.output.bias)
+        #: Per-vertex oscillator modes from X^fuse (zero gain until trained: a model
+        #: warm-started from one without dynamics starts with the same output).
+        self.oscillator_head = (OscillatorHead(width * NUM_JOINTS, config.dynamics_modes)
+                                if config.dynamics_modes else None)
         #: Whether forward adds the physics submodule (off during the supervised stage).
         self.use_physics = False
 
@@ -195,22 +219,72 @@ class GarmentDeformer(nn.Module):
         return DeformerContext(fused=fused, rest_pos=torch.cat([p.rest_pos for p in pairs]),
                                ptr=_offsets(sizes), hierarchies=[p.hierarchy for p in pairs],
                                prior_logits=prior_logits, active_channels=_active_channels(fused),
-                               motion_mask=motion_mask, velocity_mask=velocity_mask)
+                               motion_mask=motion_mask, velocity_mask=velocity_mask,
+                               body_weights=(torch.cat([p.body_weights for p in pairs])
+                                             if all(p.body_weights is not None for p in pairs)
+                                             else None))
+
+    # ---------------------------------------------------------------- dynamics
+    @property
+    def has_dynamics(self) -> bool:
+        return self.oscillator_head is not None
+
+    def oscillator_parameters(self, context: DeformerContext) -> list[OscillatorParameters]:
+        """Every pair's modes (frequency, damping, gain per vertex) from its ``X^fuse``."""
+        if self.oscillator_head is None:
+            raise ValueError("this model has no dynamics (dynamics_modes is 0)")
+        return [self.oscillator_head(context.fused[context.ptr[p]:context.ptr[p + 1]]
+                                     .flatten(1)) for p in range(context.num_pairs)]
+
+    def dynamic_blend_shapes(self, context: DeformerContext,
+                             joint_transforms: Sequence[torch.Tensor],
+                             frames: torch.Tensor, fps: float) -> torch.Tensor:
+        """The oscillators' blend shapes at chosen frames of whole sequences, in the
+        item order of :meth:`forward` (training: any frames of a sequence in one pass,
+        by the response's convolution over the sequence's history from frame 0).
+
+        Shapes: joint_transforms ``P`` tensors ``(T_p, 24, 4, 4)`` (each pair's whole
+        sequence), frames ``(P, B)`` long → ``(B · ΣN, 3)`` metres, rest frame.
+        """
+        parameters = self.oscillator_parameters(context)
+        pieces = []
+        for p, (modes, transforms) in enumerate(zip(parameters, joint_transforms,
+                                                    strict=True)):
+            rest = context.rest_pos[context.ptr[p]:context.ptr[p + 1]]
+            drive = oscillator_drive(rest, context.body_weights[context.ptr[p]:
+                                                                context.ptr[p + 1]],
+                                     transforms, fps)
+            pieces.append(oscillator_response(drive, modes, fps)[frames[p]].flatten(0, 1))
+        return pieces[0] if len(pieces) == 1 else torch.cat(pieces)
+
+    def dynamics_stream(self, context: DeformerContext, fps: float) -> DynamicsStream:
+        """A frame-by-frame carrier of the oscillators' state for the single pair of
+        ``context`` (inference in chunks)."""
+        if context.num_pairs != 1:
+            raise ValueError(f"a dynamics stream follows one pair, got {context.num_pairs}")
+        return DynamicsStream(self.oscillator_parameters(context)[0], context.rest_pos,
+                              context.body_weights, fps)
 
     # ---------------------------------------------------------------- per frame
     def forward(self, context: DeformerContext, motion_windows: torch.Tensor,
-                velocity_windows: torch.Tensor, joint_transforms: torch.Tensor
-                ) -> DeformerOutput:
+                velocity_windows: torch.Tensor, joint_transforms: torch.Tensor,
+                dynamic_offsets: torch.Tensor | None = None) -> DeformerOutput:
         """Deform every pair of ``context`` for ``B`` frames each.
 
         Shapes:
             motion_windows: ``(P, B, m, 75)`` joint axis-angles + root displacement.
             velocity_windows: ``(P, B, m, 3 N_b')`` body-subset velocities (m/s).
             joint_transforms: ``(P, B, 24, 4, 4)`` skinning transforms of the frames.
+            dynamic_offsets: ``(B · ΣN, 3)`` the oscillators' blend shapes of these
+                frames (:meth:`dynamic_blend_shapes`, :meth:`dynamics_stream`), added to
+                the submodules'; required when the model has dynamics.
 
         Returns:
             :class:`DeformerOutput` with ``V = B · ΣN`` rows.
         """
+        if self.has_dynamics and dynamic_offsets is None:
+            raise ValueError("this model has dynamics: pass dynamic_offsets (the "
+                             "oscillators' blend shapes of the frames)")
         pairs, frames = context.num_pairs, motion_windows.shape[1]
         _check_frames(motion_windows, velocity_windows, joint_transforms, pairs, self.config)
         width = self.config.feature_channels
@@ -242,6 +316,11 @@ class GarmentDeformer(nn.Module):
         blend = supervised
         if self.use_physics and self.physics_processor is not None:
             blend = supervised + self.physics_processor(x, graph, active)
+        if dynamic_offsets is not None:
+            if tuple(dynamic_offsets.shape) != tuple(blend.shape):
+                raise ValueError(f"dynamic_offsets must be {tuple(blend.shape)} (B · ΣN, 3), "
+                                 f"got {tuple(dynamic_offsets.shape)}")
+            blend = blend + dynamic_offsets.to(blend.dtype)
 
         sizes = [context.ptr[p + 1] - context.ptr[p] for p in range(pairs)]
         rest = torch.cat([context.rest_pos[context.ptr[p]:context.ptr[p + 1]].repeat(frames, 1)
@@ -252,7 +331,7 @@ class GarmentDeformer(nn.Module):
         item_ptr = torch.cat([item_sizes.new_zeros(1), torch.cumsum(item_sizes, 0)])
         return DeformerOutput(weights=weights_all, blend_shapes=blend,
                               supervised_blend_shapes=supervised, posed=posed, item=item,
-                              item_ptr=item_ptr)
+                              item_ptr=item_ptr, dynamic_blend_shapes=dynamic_offsets)
 
     def _graph_levels(self, context: DeformerContext, frames: int,
                       device: torch.device) -> GraphLevels:
@@ -267,6 +346,40 @@ class GarmentDeformer(nn.Module):
             graph.unpool = [u.to(device) for u in graph.unpool]
             context._graphs[frames] = graph
         return context._graphs[frames]
+
+
+class DynamicsStream:
+    """The oscillators of one garment–body pair run chunk by chunk: the state (and the two
+    previous frames the drive's acceleration needs) carried from one chunk to the next,
+    so a sequence in chunks gets the blend shapes of one pass (a test: within 1e-5 m).
+
+    Args:
+        parameters: the pair's modes; rest_pos ``(N, 3)``; body_weights ``(N, 24)``;
+        fps: frames per second of the motion.
+    """
+
+    def __init__(self, parameters: OscillatorParameters, rest_pos: torch.Tensor,
+                 body_weights: torch.Tensor | None, fps: float):
+        if body_weights is None:
+            raise ValueError("dynamics need the pair's body skinning weights")
+        self.parameters, self.rest_pos, self.body_weights, self.fps = (
+            parameters, rest_pos, body_weights, fps)
+        self.state = OscillatorState.start(rest_pos.shape[0], parameters.frequency.shape[1],
+                                           rest_pos.device)
+        self._history: torch.Tensor | None = None   # (2, 24, 4, 4): the last two frames
+
+    def advance(self, joint_transforms: torch.Tensor) -> torch.Tensor:
+        """Blend shapes ``(B, N, 3)`` (metres, rest frame) of the next ``B`` frames, given
+        their joint transforms ``(B, 24, 4, 4)``."""
+        history = (joint_transforms[:1].expand(2, -1, -1, -1) if self._history is None
+                   else self._history)
+        extended = torch.cat([history.to(joint_transforms.dtype), joint_transforms])
+        # The drive's backward difference sees the two frames before the chunk, as in
+        # one pass (whose frames before 0 are frame 0: the same as this first history).
+        drive = oscillator_drive(self.rest_pos, self.body_weights, extended, self.fps)[2:]
+        offsets, self.state = self.state.advance(drive, self.parameters, self.fps)
+        self._history = extended[-2:]
+        return offsets
 
 
 def motion_input_masks(prior_logits: torch.Tensor, body_distances: torch.Tensor

@@ -90,6 +90,11 @@ class TrainingConfig:
             reductions otherwise sum in a thread-dependent order): two runs of one
             config and seed give bitwise-equal weights with any thread count
             (docs/reliability.md has the measured cost).
+        initial_weights: a model checkpoint whose weights start a new run (fine-tuning,
+            e.g. adding ``model.dynamics_modes`` to a trained model); the parts of this
+            model it has no weights for (the oscillators) keep their initialisation,
+            every other weight must fit. Empty: a fresh initialisation. Ignored when a
+            run resumes (its own checkpoint has every weight).
     """
 
     data: str = "data/paper"
@@ -106,6 +111,7 @@ class TrainingConfig:
     threads: int = 0
     validate_every: int = 1
     deterministic: bool = True
+    initial_weights: str = ""
 
     def __post_init__(self) -> None:
         """Check ranges before any work starts (``epochs: 0`` would report a checkpoint

@@ -44,8 +44,13 @@ class TrainingStep(nn.Module):
 
     def forward(self, batch: TrainingBatch) -> DeformerOutput:
         context = self.model.encode(batch.pairs)
+        offsets = None
+        if self.model.has_dynamics:
+            assert batch.sequence_transforms is not None
+            offsets = self.model.dynamic_blend_shapes(
+                context, batch.sequence_transforms, torch.as_tensor(batch.frames), batch.fps)
         return self.model(context, batch.motion_windows, batch.velocity_windows,
-                          batch.joint_transforms)
+                          batch.joint_transforms, offsets)
 
 
 def _check_cache_fits(dataset: PreparedDataset, model: ModelConfig) -> None:
@@ -58,6 +63,39 @@ def _check_cache_fits(dataset: PreparedDataset, model: ModelConfig) -> None:
         raise ValueError(f"{dataset.root}: {name}: {error}: the cache was prepared for "
                          "another model config (rebuild it, or change the model config)"
                          ) from None
+
+
+#: Parameters a model may have that an older checkpoint lacks, by name prefix: they keep
+#: their initialisation when the checkpoint starts a run (``initial_weights``).
+ADDED_MODULES = ("oscillator_head.",)
+
+
+def warm_start(model: GarmentDeformer, path: str | Path) -> None:
+    """Load a model checkpoint's weights into ``model``; only the parameters of
+    :data:`ADDED_MODULES` may be absent from it (the oscillator head starts at zero gain,
+    so the warm-started model's output equals the checkpoint's).
+
+    Raises:
+        ValueError: unreadable, or a weight is missing, extra or of another shape
+            (names the file and the first such key).
+    """
+    payload = load_checkpoint(path)
+    state = payload.get("model_state")
+    if not isinstance(state, dict):
+        raise ValueError(f"{path}: not a model checkpoint (no model_state)")
+    own = model.state_dict()
+    for key, value in state.items():
+        if key not in own:
+            raise ValueError(f"{path}: weight '{key}' has no place in this model "
+                             "(initial_weights must come from the same architecture)")
+        if tuple(value.shape) != tuple(own[key].shape):
+            raise ValueError(f"{path}: weight '{key}' has shape {tuple(value.shape)}, this "
+                             f"model's is {tuple(own[key].shape)} (another model config)")
+    absent = [key for key in own if key not in state and not key.startswith(ADDED_MODULES)]
+    if absent:
+        raise ValueError(f"{path}: has no weight '{absent[0]}' of this model "
+                         f"({len(absent)} missing)")
+    model.load_state_dict(state, strict=False)
 
 
 def set_stage(model: GarmentDeformer, stage: str) -> None:
@@ -136,6 +174,8 @@ class Trainer:
         for dataset in (train, validation):
             if dataset is not None and len(dataset):
                 _check_cache_fits(dataset, config.model)
+        if config.initial_weights:
+            warm_start(self.model, config.initial_weights)
         self.step_module: nn.Module = TrainingStep(self.model)
         self._wrapped_stage: str | None = None
         self.optimiser = torch.optim.Adamax(self.model.parameters(), lr=config.learning_rate)
