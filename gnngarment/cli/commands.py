@@ -441,6 +441,18 @@ def _export_name(garment_mesh: Path) -> str:
     return name.lstrip(".") or "garment"
 
 
+def _refuse_outputs_over_inputs(out: Path, name: str, formats: list[str], include_body: bool,
+                                inputs: list[Path | None]) -> None:
+    from gnngarment.inference.export.export import export_paths
+    from gnngarment.inference.output_folder import check_outputs_spare_inputs
+
+    files, folders = export_paths(out, name, formats, include_body)
+    try:
+        check_outputs_spare_inputs(files, folders, [p for p in inputs if p is not None])
+    except ValueError as error:
+        raise fail(str(error)) from None
+
+
 def _hold_output_folder(context: typer.Context, out: Path):
     """Before any work: lock ``out`` for the rest of the command (released when it ends,
     or by the kernel if it is killed). A second ``animate`` into the same folder is
@@ -604,6 +616,9 @@ def animate(
                            scale, offset, influences)
     lead_in_seconds = _lead_in_seconds(motion, lead_in)
     checkpoint = checkpoint or SHIPPED_MODEL
+    _refuse_outputs_over_inputs(out, _export_name(garment_mesh), format_list, body,
+                                [garment_mesh, checkpoint, source_body, joint_map,
+                                 Path(motion), Path(body_shape)])
     use_idle_cores()
     try:
         model = load_model(checkpoint)

@@ -47,3 +47,27 @@ def check_writable_folder(out: str | Path) -> None:
         os.rmdir(tempfile.mkdtemp(prefix=".probe-", dir=existing))
     except OSError as error:
         raise PermissionError(f"cannot write in {existing} ({error.strerror})") from None
+
+
+def check_outputs_spare_inputs(files: list[Path], folders: list[Path],
+                               inputs: list[Path]) -> None:
+    """Before any work: no output file is (or, through symlinks, resolves to) one of the
+    command's input files, and no input lies inside an output folder whose contents the
+    command replaces — a user's garment must never be overwritten by its own result.
+
+    Raises:
+        ValueError: naming the input and the output that would overwrite it.
+    """
+    for given in inputs:
+        if not given.is_file():
+            continue
+        source = given.resolve()
+        for output in files:
+            target = output.resolve()
+            if target == source or (output.exists() and os.path.samefile(output, given)):
+                raise ValueError(f"{given}: the output {output} would overwrite this input "
+                                 "(choose another --out folder)")
+        for folder in folders:
+            if source.is_relative_to(folder.resolve()):
+                raise ValueError(f"{given}: this input lies in {folder}, whose files the "
+                                 "export replaces (choose another --out folder)")

@@ -37,6 +37,7 @@ def atomic_write(path: str | Path, write: Callable[[BinaryIO], None]) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     # A hidden name with our suffix: globs over "*.npz", "*.obj" or "*.pc2" never see it.
     temp = path.with_name(f".{path.name}.{secrets.token_hex(4)}{TEMP_SUFFIX}")
+    _record_temporary(temp)
     # os.open with 0o666 lets the umask decide permissions, like a plain open() would
     # (tempfile's 0o600 would make shared outputs unreadable to others).
     descriptor = os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0),
@@ -65,6 +66,20 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
 TEMP_NAME = re.compile(r"^\..+\.[0-9a-f]{8}" + re.escape(TEMP_SUFFIX) + r"$")
 
 
+#: The locks this process holds, by resolved folder: a temporary made inside one is
+#: recorded in its lock file before it exists, so that after a kill -9 the next run
+#: removes what this run made, and nothing else.
+_HELD: dict[Path, FolderLock] = {}
+
+
+def _record_temporary(temp: Path) -> None:
+    resolved = temp.parent.resolve() / temp.name
+    for folder, lock in _HELD.items():
+        if resolved.is_relative_to(folder):
+            lock.record(resolved.relative_to(folder))
+            return
+
+
 class FolderBusyError(OSError):
     """Another process holds the output folder's lock (the message names it)."""
 
@@ -78,6 +93,10 @@ class FolderLock:
     kill -9, so a stale lock never blocks the next run.
 
     Use as a context manager; :meth:`remove_stale_temporaries` is safe only while held.
+    While it is held, every temporary :func:`atomic_write` makes in the folder (or below
+    it) is recorded in the lock file before it is created; the next holder removes
+    exactly those a killed run left, never a file of the same look that this library
+    did not make (a user's, or one reached through a symlink).
     """
 
     def __init__(self, folder: str | Path, what: str = "run") -> None:
@@ -95,38 +114,64 @@ class FolderLock:
             fcntl.flock(stream.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
             stream.seek(0)
-            holder = stream.read().decode(errors="replace").strip() or "another process"
+            first = stream.read().decode(errors="replace").strip().splitlines()[:1]
+            holder = first[0] if first else "another process"
             stream.close()
             raise FolderBusyError(f"{self.folder}: another {self.what} ({holder}) is writing "
                                   "here; wait for it to finish or choose another output "
                                   "folder") from None
         stream.seek(0)
+        self._stale = [line[len("temp "):] for line in
+                       stream.read().decode(errors="replace").splitlines()
+                       if line.startswith("temp ")]
+        stream.seek(0)
         stream.truncate()
-        stream.write(f"pid {os.getpid()}".encode())
+        stream.write(f"pid {os.getpid()}\n".encode())
         stream.flush()
         self._stream = stream
+        self._resolved = self.folder.resolve()
+        _HELD[self._resolved] = self
         return self
 
     def __exit__(self, *exc_info: object) -> None:
         if self._stream is not None:
+            _HELD.pop(self._resolved, None)
+            # Every temporary of this run is renamed or removed by now (atomic_write's
+            # own cleanup): the record is of no further use.
+            self._stream.seek(0)
+            self._stream.truncate()
+            self._stream.write(f"pid {os.getpid()}\n".encode())
             self._stream.close()  # closing releases the flock
             self._stream = None
 
+    def record(self, relative: Path) -> None:
+        """Note a temporary (relative to the folder) before it is created."""
+        if self._stream is not None:
+            self._stream.seek(0, os.SEEK_END)
+            self._stream.write(f"temp {relative.as_posix()}\n".encode())
+            # Flushed to the kernel, which keeps it when the process is killed (no fsync:
+            # a power cut loses the temporaries' data too, and readers ignore them).
+            self._stream.flush()
+
     def remove_stale_temporaries(self, subfolders: tuple[str, ...]) -> int:
-        """Delete the temporary files a killed earlier run left in ``subfolders`` (only
-        names :func:`atomic_write` makes; any other file, hidden or not, is the user's).
-        Returns how many were removed."""
+        """Delete the temporary files a killed earlier run of this library recorded in
+        the lock file, in ``subfolders`` (``"."``: the folder itself, not below; others
+        recursively). Only a regular file (not a symlink) inside the resolved folder whose
+        name :func:`atomic_write` makes; any other file, hidden or not, is the user's and
+        stays. Returns how many were removed."""
         if self._stream is None:
             raise RuntimeError("remove_stale_temporaries needs the lock held")
         removed = 0
-        for name in subfolders:
-            folder = self.folder / name
-            if not folder.is_dir():
+        for relative in self._stale:
+            parts = Path(relative).parts
+            inside = any((name == "." and len(parts) == 1) or
+                         (name != "." and len(parts) > 1 and parts[0] == name)
+                         for name in subfolders)
+            if not inside or ".." in parts or Path(relative).is_absolute():
                 continue
-            # The folder itself only at the top ("."), its subfolders recursively.
-            found = folder.glob if name == "." else folder.rglob
-            for path in found(f".*{TEMP_SUFFIX}"):
-                if TEMP_NAME.match(path.name) and path.is_file():
-                    path.unlink(missing_ok=True)
-                    removed += 1
+            path = self._resolved / relative
+            if (TEMP_NAME.match(path.name) and not path.is_symlink() and path.is_file()
+                    and path.parent.resolve().is_relative_to(self._resolved)):
+                path.unlink(missing_ok=True)
+                removed += 1
         return removed

@@ -305,7 +305,7 @@ def test_a_second_run_into_a_busy_folder_is_refused_and_a_killed_one_leaves_noth
     try:
         deadline = time.monotonic() + 300
         lock = out / ".lock"
-        while not (lock.is_file() and lock.read_text() == f"pid {first.pid}"):
+        while not (lock.is_file() and lock.read_text().startswith(f"pid {first.pid}\n")):
             assert first.poll() is None and time.monotonic() < deadline
             time.sleep(0.02)
         before = _tree(out)
@@ -328,3 +328,51 @@ def test_a_second_run_into_a_busy_folder_is_refused_and_a_killed_one_leaves_noth
     written = sorted(p.name for p in frames.glob("garment_*.obj"))
     assert len(written) == manifest["frames"] == 7, written[:3]
     assert os.path.getsize(out / "skirt.pc2") > 0
+
+
+def animate_args(garment: Path, checkpoint: Path, out: Path, formats: str = "glb") -> list[str]:
+    return ["animate", str(garment), "--checkpoint", str(checkpoint), "--out", str(out),
+            "--duration", "0.2", "--format", formats, "--no-body"]
+
+
+@pytest.mark.parametrize("place", ["the export's own name", "a symlink to the input",
+                                   "the OBJ sequence folder"])
+def test_an_output_never_overwrites_the_input_garment(files, tmp_path: Path, place) -> None:
+    """Issue 38: `animate OUT/skirt.glb --out OUT --format glb` replaced the user's garment
+    with its own result. Refused before any work, the input as it was."""
+    out = tmp_path / "out"
+    out.mkdir()
+    skirt = trimesh.load(files["garment"], process=False)
+    if place == "the export's own name":
+        garment, formats = out / "skirt.glb", "glb"
+        skirt.export(garment)
+    elif place == "a symlink to the input":
+        garment, formats = tmp_path / "skirt.obj", "pc2"
+        skirt.export(garment)
+        (out / "skirt_rest.obj").symlink_to(garment)   # what pc2 writes beside it
+    else:
+        garment, formats = out / "skirt_obj" / "skirt.obj", "obj"
+        garment.parent.mkdir()
+        skirt.export(garment)
+    before = garment.read_bytes()
+    result = runner.invoke(app, animate_args(garment, files["checkpoint"], out, formats))
+    assert result.exit_code == 2, result.output
+    assert "would overwrite" in result.output or "replaces" in result.output, result.output
+    assert garment.read_bytes() == before
+
+
+def test_a_file_named_like_our_temporaries_is_the_users(files, tmp_path: Path) -> None:
+    """Issue 38: `animate` deleted hand-placed `.x.0123abcd.tmp` files, also through a
+    symlinked --out. Only temporaries a run of ours recorded are ever removed."""
+    user = tmp_path / "user"
+    user.mkdir()
+    lookalikes = [".x.0123abcd.tmp", ".skirt.glb.0123abcd.tmp", ".manifest.json.0123abcd.tmp"]
+    for name in lookalikes:
+        (user / name).write_text("the user's")
+    out = tmp_path / "linked"
+    out.symlink_to(user)
+    result = runner.invoke(app, animate_args(files["garment"], files["checkpoint"], out))
+    assert result.exit_code == 0, result.output
+    assert (user / "skirt.glb").is_file()
+    for name in lookalikes:
+        assert (user / name).read_text() == "the user's", name

@@ -21,7 +21,7 @@ Layout of ``out_dir`` for ``name="skirt"`` (each file written atomically)::
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from contextlib import nullcontext
 from numbers import Integral
 from pathlib import Path
@@ -108,6 +108,24 @@ def export_animation(animation: Animation, out_dir: str | Path, name: str,
         if "obj" in formats and previous is not None:
             _remove_stale_frames(paths["obj"], previous, first_frame, len(animation.posed))
     return paths
+
+
+def export_paths(out_dir: str | Path, name: str, formats: Sequence[str], include_body: bool
+                 ) -> tuple[list[Path], list[Path]]:
+    """What :func:`export_animation` writes into ``out_dir``: ``(files, folders)``, each
+    folder's contents being replaced too — so a command can refuse, before any work, an
+    output that would overwrite one of its inputs."""
+    out = Path(out_dir)
+    files = [out / f"{name}_export.json"]
+    if "glb" in formats:
+        files.append(out / f"{name}.glb")
+    if "pc2" in formats:
+        files += [out / f"{name}.pc2", out / f"{name}_rest.obj"]
+        if include_body:
+            files += [out / f"{name}_body.pc2", out / f"{name}_body.obj"]
+    files += [out / f"{name}.{preview}" for preview in ("gif", "mp4") if preview in formats]
+    folders = [out / f"{name}_obj"] if "obj" in formats else []
+    return files, folders
 
 
 def _previous_frames(manifest: Path) -> tuple[int, int] | None:

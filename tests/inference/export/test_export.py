@@ -164,11 +164,16 @@ def test_a_second_export_into_a_busy_folder_is_refused_and_stale_temporaries_go(
     with FolderLock(tmp_path, "export"), pytest.raises(FolderBusyError, match="another export"):
         export_animation(animation, tmp_path, "skirt", formats=("pc2",))
     assert not (tmp_path / "skirt.pc2").exists()
-    # A killed export's temporary file (atomic_write's name pattern) and a user's file.
+    # A killed export's temporary file, as its lock file recorded it; a user's file, and
+    # one the user named like ours (not recorded: it stays).
     (tmp_path / "skirt_obj").mkdir()
     killed = tmp_path / "skirt_obj" / ".garment_0000.obj.0123abcd.tmp"
     killed.write_bytes(b"x" * 100)
+    (tmp_path / ".lock").write_text("pid 1\ntemp skirt_obj/.garment_0000.obj.0123abcd.tmp\n")
     draft = tmp_path / ".draft.tmp"
     draft.write_text("mine")
+    lookalike = tmp_path / "skirt_obj" / ".garment_0001.obj.0123abcd.tmp"
+    lookalike.write_text("mine too")
     export_animation(animation, tmp_path, "skirt", formats=("obj",))
     assert not killed.exists() and draft.read_text() == "mine"
+    assert lookalike.read_text() == "mine too"
