@@ -148,7 +148,7 @@ def main() -> None:
         # The network's own output: collision resolution moves vertices, not dynamics.
         animation = animate(model, record.rest_pos, record.faces, body, frames,
                             resolve_collisions=False)
-        rows[checkpoint.name] = animation.posed
+        rows[str(checkpoint) if checkpoint.name in rows else checkpoint.name] = animation.posed
     print(f"{garment} ({plan.design.fabric}, {len(record.rest_pos)} vertices, hem "
           f"{len(hem)}), {args.motion} {args.move:g} s then still {args.hold:g} s, {fps:g} fps")
     print("| method | hem speed at the stop m/s | 0.3 s later m/s | decay time s | "
