@@ -69,6 +69,9 @@ def attribute_command(
     ignore_placement: Annotated[bool, typer.Option(
         help="Attribute even if the garment does not sit on the rest body (the heatmap of "
         "a misplaced garment explains a deformation it would never get).")] = False,
+    allow_unverified: Annotated[bool, typer.Option(
+        "--allow-unverified", help="Load a checkpoint that has no content hash (a change to "
+        "it cannot be detected; docs/reliability.md).")] = False,
 ) -> None:
     """Integrated-gradient heatmap (paper Eq. 9) of a predicted deformation: PNG, PLY,
     NPZ and JSON in --out."""
@@ -116,7 +119,7 @@ def attribute_command(
 
     use_idle_cores()
     try:
-        model = load_model(checkpoint)
+        model = load_model(checkpoint, allow_unverified)
         pos, faces = load_mesh(garment_mesh)
         source = None if source_body is None else load_mesh(source_body)
     except (ValueError, MeshError) as error:

@@ -347,6 +347,11 @@ def train(
                           f"({switch['reason']})")
 
 
+#: ``--allow-unverified`` of the commands that load a model.
+ALLOW_UNVERIFIED_HELP = ("Load a checkpoint that has no content hash (a change to it cannot "
+                         "be detected; docs/reliability.md says how to re-hash one).")
+
+
 @app.command()
 def evaluate(
     checkpoint: Annotated[Path, typer.Option(help="Model checkpoint (.pt).")],
@@ -357,6 +362,7 @@ def evaluate(
                          ] = None,
     markdown: Annotated[Path | None, typer.Option(help="Write the Markdown table.")] = None,
     spurious: Annotated[bool, typer.Option(help="Run the spurious-correlation test.")] = True,
+    allow_unverified: Annotated[bool, typer.Option(help=ALLOW_UNVERIFIED_HELP)] = False,
 ) -> None:
     """Report E_verts, E_norm, collision rate, Hausdorff, STED and the spurious-correlation
     test per garment type, for the model and the body-skinning baseline: of the output
@@ -372,9 +378,10 @@ def evaluate(
         check_output_file(option, path)
     use_idle_cores()
     try:
-        model = load_model(checkpoint)
+        model = load_model(checkpoint, allow_unverified)
         if data is None:
-            data = Path(json_module.loads(load_checkpoint(checkpoint)["training_config"])["data"])
+            data = Path(json_module.loads(load_checkpoint(
+                checkpoint, allow_unverified)["training_config"])["data"])
         dataset = PreparedDataset(data, split, model.config.window)
     except (CacheError, ValueError, KeyError) as error:
         raise fail(str(error)) from None
@@ -598,6 +605,7 @@ def animate(
         help="Move garment vertices out of the body (closer than epsilon, "
              "configs/collisions.yaml), the rest garment and every frame.")] = True,
     lead_in: Annotated[float | None, typer.Option(help=LEAD_IN_HELP)] = None,
+    allow_unverified: Annotated[bool, typer.Option(help=ALLOW_UNVERIFIED_HELP)] = False,
 ) -> None:
     """Animate a garment mesh on a body and motion; write OBJ/PC2/glb/GIF."""
     from tqdm import tqdm
@@ -621,7 +629,7 @@ def animate(
                                  Path(motion), Path(body_shape)])
     use_idle_cores()
     try:
-        model = load_model(checkpoint)
+        model = load_model(checkpoint, allow_unverified)
         pos, faces, uv, uv_faces = load_textured_mesh(garment_mesh)
         source = None if source_body is None else load_mesh(source_body)
     except (MeshError, ValueError) as error:

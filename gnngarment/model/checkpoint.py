@@ -91,10 +91,17 @@ def save_checkpoint(path: str | Path, payload: dict[str, Any]) -> None:
     atomic_write(path, lambda stream: torch.save(payload, stream))
 
 
-def load_checkpoint(path: str | Path) -> dict[str, Any]:
+#: How to give an old checkpoint a content hash (docs/reliability.md).
+REHASH_HINT = ("python -c \"from gnngarment.model.checkpoint import rehash_checkpoint; "
+               "rehash_checkpoint('<file>')\"")
+
+
+def load_checkpoint(path: str | Path, allow_unverified: bool = False) -> dict[str, Any]:
     """Load a checkpoint safely (no pickled code: ``weights_only=True``) and check its
-    content hash. A checkpoint saved before hashes were stored (no ``content_hash``
-    key, e.g. the shipped ``models/gnngarment-small.pt`` of 0.1.0) loads unchecked.
+    content hash. One without a ``content_hash`` key (saved before hashes were stored,
+    or with the key removed: a change to it cannot be detected) is refused unless
+    ``allow_unverified`` (``--allow-unverified``); :func:`rehash_checkpoint` gives a
+    trusted one a hash.
 
     Raises:
         ValueError: missing, truncated, corrupt (content hash mismatch) or foreign file
@@ -120,10 +127,22 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
         raise ValueError(f"{path}: not a gnngarment checkpoint (format "
                          f"{payload.get('format_version') if isinstance(payload, dict) else '?'})")
     stored = payload.get(CONTENT_HASH_KEY)
+    if stored is None and not allow_unverified:
+        raise ValueError(f"{path}: has no content hash, so a change to it cannot be "
+                         "detected; load it only if you trust its source "
+                         f"(--allow-unverified), or re-hash it once: {REHASH_HINT}")
     if stored is not None and stored != content_hash(payload):
         raise ValueError(f"{path} is corrupt: content hash mismatch (its contents changed "
                          "after it was saved; use another copy)")
     return payload
+
+
+def rehash_checkpoint(path: str | Path) -> Path:
+    """Give a trusted checkpoint without a content hash one (rewritten atomically), so it
+    loads without ``--allow-unverified``. Only for a file whose source you trust: the hash
+    then certifies its present contents."""
+    save_checkpoint(path, load_checkpoint(path, allow_unverified=True))
+    return Path(path)
 
 
 def model_payload(model: GarmentDeformer) -> dict[str, Any]:
@@ -165,17 +184,22 @@ def model_with_weights(config: ModelConfig, state: dict[str, Any], mismatch: str
     return model
 
 
-def load_model(path: str | Path) -> GarmentDeformer:
-    """Rebuild a model from a checkpoint, in eval mode.
+def load_model(path: str | Path, allow_unverified: bool = False) -> GarmentDeformer:
+    """Rebuild a model from a checkpoint, in eval mode (``allow_unverified``: see
+    :func:`load_checkpoint`). Its config is validated (types and ranges, like a YAML
+    model config) before anything is built.
 
     Raises:
         ValueError: unreadable, or its weights do not fit its model config (names it).
     """
-    payload = load_checkpoint(path)
+    payload = load_checkpoint(path, allow_unverified)
     # A training-state file or a foreign torch file of the same format: no model in it.
     missing = [key for key in ("model_config", "model_state") if key not in payload]
     if missing:
         raise ValueError(f"{path}: not a model checkpoint (no {' or '.join(missing)})")
+    if not isinstance(payload["model_config"], dict):
+        raise ValueError(f"{path}: model_config is a {type(payload['model_config']).__name__}, "
+                         "expected a mapping of settings")
     config = stored_model_config(payload["model_config"], source=str(path))
     model = model_with_weights(config, payload["model_state"],
                                f"{path}: the weights do not fit the model its config "

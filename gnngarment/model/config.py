@@ -21,6 +21,17 @@ WEIGHT_PRIORS = ("body", "none")
 #: Most oscillator modes per vertex (``dynamics_modes``).
 MAX_DYNAMICS_MODES = 8
 
+#: Most channels of any layer, and most body vertices / landmarks / history frames: a
+#: config (a YAML file or a checkpoint's) asking for more is refused before a tensor is
+#: allocated (the paper's network has at most 512 channels; 200,000 would take all of
+#: this machine's memory).
+MAX_CHANNELS = 4096
+MAX_HEADS = 64
+#: Most per-joint feature channels ``F`` (the paper's 128, twice over): E^t2's LSTM is
+#: ``24 F`` wide, its weights grow as ``F²``.
+MAX_FEATURE_CHANNELS = 256
+MAX_WINDOW = 120
+
 #: Most pooling levels of the multilevel processor (and of a garment's hierarchy that a
 #: model can use); a small garment stops shrinking well before this.
 MAX_LEVELS = 6
@@ -148,6 +159,20 @@ class ModelConfig:
         if self.dynamics_modes and self.weight_prior != "body":
             raise ValueError("dynamics_modes needs weight_prior 'body' (the oscillators are "
                              "driven by the body-skinning frame of every vertex)")
+        for name in ("garment_channels", "style_channels", "body_channels"):
+            if max(getattr(self, name)) > MAX_CHANNELS:
+                raise ValueError(f"{name} must be at most {MAX_CHANNELS} channels, "
+                                 f"got {getattr(self, name)}")
+        if width > MAX_FEATURE_CHANNELS:
+            raise ValueError(f"garment_channels[-1] (F) must be at most {MAX_FEATURE_CHANNELS} "
+                             f"(the velocity LSTM is 24 F wide), got {width}")
+        limits = {"motion_hidden": MAX_CHANNELS, "processor_channels": MAX_CHANNELS,
+                  "landmarks": MAX_CHANNELS, "body_vertices": MAX_CHANNELS,
+                  "processor_heads": MAX_HEADS, "output_heads": MAX_HEADS,
+                  "motion_layers": 16, "window": MAX_WINDOW}
+        for name, limit in limits.items():
+            if getattr(self, name) > limit:
+                raise ValueError(f"{name} must be at most {limit}, got {getattr(self, name)}")
         for name in ("motion_layers", "processor_channels", "processor_heads", "output_heads",
                      "landmarks", "body_vertices", "window"):
             if getattr(self, name) < 1:

@@ -134,6 +134,13 @@ def inputs(tmp_path_factory: pytest.TempPathFactory, anny_body) -> dict[str, Pat
     save_checkpoint(folder / "tiny.pt", payload)
     paths["tiny"] = folder / "tiny.pt"
     whole = (folder / "tiny.pt").read_bytes()
+    # Its hash key removed and a weight scaled: a tampered file that no longer says so.
+    tampered = torch.load(folder / "tiny.pt", weights_only=True)
+    del tampered["content_hash"]
+    first = next(iter(tampered["model_state"]))
+    tampered["model_state"][first] = tampered["model_state"][first] * 1000
+    torch.save(tampered, folder / "unhashed.pt")
+    paths["unhashed_pt"] = folder / "unhashed.pt"
     write("garbage.pt", b"not a checkpoint at all" * 10)
     write("truncated.pt", whole[: len(whole) // 2])
     with zipfile.ZipFile(folder / "other.pt", "w") as archive:
@@ -260,6 +267,12 @@ CASES: dict[str, Case] = {
     "animate-ckpt-garbage": Case(
         [*ANIMATE, "--checkpoint", "$garbage_pt"],
         "$garbage_pt: not a readable gnngarment checkpoint"),
+    "animate-ckpt-unhashed": Case(
+        [*ANIMATE, "--checkpoint", "$unhashed_pt"],
+        "$unhashed_pt: has no content hash"),
+    "evaluate-ckpt-unhashed": Case(
+        ["evaluate", "--checkpoint", "$unhashed_pt", "--data", "$cache", "--no-spurious"],
+        "$unhashed_pt: has no content hash"),
     "animate-ckpt-truncated": Case(
         [*ANIMATE, "--checkpoint", "$truncated_pt"],
         "$truncated_pt: not a readable gnngarment checkpoint (PytorchStreamReader failed reading "

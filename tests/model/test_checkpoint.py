@@ -47,11 +47,11 @@ def test_flipped_tensor_bytes_are_refused_naming_the_file(model: GarmentDeformer
     load_model(path)  # the intact file still loads
 
 
-def test_checkpoint_without_a_hash_loads_unchecked(model: GarmentDeformer,
-                                                   tmp_path: Path) -> None:
+def test_checkpoint_without_a_hash_loads_unchecked_when_asked(model: GarmentDeformer,
+                                                              tmp_path: Path) -> None:
     path = tmp_path / "old.pt"  # as saved before hashes were stored
     torch.save({"format_version": CHECKPOINT_FORMAT_VERSION, **model_payload(model)}, path)
-    loaded = load_model(path)
+    loaded = load_model(path, allow_unverified=True)
     for (name, a), b in zip(model.state_dict().items(), loaded.state_dict().values(),
                             strict=True):
         assert torch.equal(a, b), name
@@ -91,3 +91,57 @@ def test_a_release_can_set_a_reach_but_not_change_the_network(model: GarmentDefo
         with pytest.raises(ValueError, match=message):
             release_checkpoint(path, tmp_path / "refused.pt", settings)
     assert not (tmp_path / "refused.pt").exists()
+
+
+def _tiny_checkpoint(path):
+    from gnngarment.model import GarmentDeformer
+    from gnngarment.model.checkpoint import model_payload, save_checkpoint
+    from tests.model.pairs import tiny_config
+
+    torch.manual_seed(0)
+    save_checkpoint(path, model_payload(GarmentDeformer(tiny_config())))
+    return path
+
+
+def test_a_checkpoint_without_its_hash_loads_only_when_asked(tmp_path) -> None:
+    """Issue 38: deleting the hash key let a tampered checkpoint (weights x 1000) load
+    unchecked as 'legacy'."""
+    from gnngarment.model.checkpoint import (
+        CONTENT_HASH_KEY,
+        load_checkpoint,
+        load_model,
+        rehash_checkpoint,
+    )
+
+    path = _tiny_checkpoint(tmp_path / "model.pt")
+    payload = torch.load(path, weights_only=True)
+    del payload[CONTENT_HASH_KEY]
+    name = next(iter(payload["model_state"]))
+    payload["model_state"][name] = payload["model_state"][name] * 1000
+    torch.save(payload, path)
+    with pytest.raises(ValueError, match="no content hash.*--allow-unverified"):
+        load_model(path)
+    assert load_model(path, allow_unverified=True) is not None
+    rehash_checkpoint(path)
+    assert CONTENT_HASH_KEY in load_checkpoint(path)
+
+
+@pytest.mark.parametrize("change, message", [
+    ("a string", "model_config is a str"),
+    ({"garment_channels": [8, 200_000, 200_000]}, "garment_channels"),
+    ({"body_vertices": 10**7}, "body_vertices"),
+    ({"window": 10**6}, "window"),
+])
+def test_a_checkpoint_config_is_validated_before_anything_is_built(tmp_path, change,
+                                                                   message) -> None:
+    """A config that is not a mapping, or that asks for absurd sizes, is refused by name
+    before a tensor is allocated (200,000 channels ran this machine out of memory)."""
+    from gnngarment.model.checkpoint import load_model, save_checkpoint
+
+    path = _tiny_checkpoint(tmp_path / "model.pt")
+    payload = torch.load(path, weights_only=True)
+    payload["model_config"] = change if isinstance(change, str) else {
+        **payload["model_config"], **change}
+    save_checkpoint(path, payload)
+    with pytest.raises(ValueError, match=message):
+        load_model(path)
