@@ -23,6 +23,10 @@ from gnngarment.model.deformer import GarmentDeformer
 #: no cost in speed: one 2k-vertex garment already saturates a CPU (docs/attribution.md).
 DEFAULT_BATCH_VERTICES = 10_000
 
+#: Most quadrature points: Gauss–Legendre with 50 is exact to float32 for this
+#: integrand (docs/attribution.md); 1,000 is 20 times the paper's, and time grows with it.
+MAX_STEPS = 1000
+
 
 class FeatureResponse:
     """``f(X)``: a scalar output of the deformer as a function of the graph features.
@@ -122,8 +126,9 @@ def attribute(model: GarmentDeformer, pair: GarmentBodyPair,
         raise ValueError(f"unknown output '{output}' (expected one of {OUTPUTS})")
     if reduction not in REDUCTIONS:
         raise ValueError(f"unknown reduction '{reduction}' (expected one of {REDUCTIONS})")
-    if isinstance(n_steps, bool) or not isinstance(n_steps, int) or n_steps < 1:
-        raise ValueError(f"n_steps must be a positive integer, got {n_steps!r}")
+    if (isinstance(n_steps, bool) or not isinstance(n_steps, int)
+            or not 1 <= n_steps <= MAX_STEPS):
+        raise ValueError(f"n_steps must be an integer in 1..{MAX_STEPS}, got {n_steps!r}")
     if internal_batch_size is None:
         internal_batch_size = max(1, min(n_steps, DEFAULT_BATCH_VERTICES // n))
     elif internal_batch_size < 1:

@@ -57,9 +57,15 @@ class Motion:
             )
         if not np.all(np.isfinite(rotations)) or not np.all(np.isfinite(translation)):
             raise MotionError(f"{where}rotations/translation contain NaN or infinite values")
-        fps = float(self.fps)
-        if not np.isfinite(fps) or fps <= 0:
-            raise MotionError(f"{where}fps must be > 0, got {self.fps}")
+        from gnngarment.body.motion_limits import MAX_SOURCE_FPS
+
+        try:
+            fps = float(self.fps)
+        except (TypeError, ValueError):
+            raise MotionError(f"{where}fps must be a number, got {self.fps!r}") from None
+        if not np.isfinite(fps) or not 0 < fps <= MAX_SOURCE_FPS:
+            raise MotionError(f"{where}fps must be > 0 and at most {MAX_SOURCE_FPS:g}, "
+                              f"got {self.fps}")
         object.__setattr__(self, "rotations", rotations)
         object.__setattr__(self, "translation", translation)
         object.__setattr__(self, "fps", fps)

@@ -109,7 +109,11 @@ def load_amass_motion(
         raise MotionError(f"{path}: 'poses' must be (T, 72|156|165), got {poses.shape}")
     body = np.zeros((poses.shape[0], 72))
     body[:, : 72 if poses.shape[1] == 72 else 66] = poses[:, : 72 if poses.shape[1] == 72 else 66]
-    fps = float(np.asarray(data[fps_key]))
+    try:
+        fps = float(np.asarray(data[fps_key], dtype=np.float64).reshape(-1)[0])
+    except (TypeError, ValueError, IndexError):
+        raise MotionError(f"{path}: '{fps_key}' must be a number, got {data[fps_key]!r}"
+                          ) from None
     if not np.isfinite(fps) or fps <= 0:
         raise MotionError(f"{path}: mocap frame rate must be > 0, got {fps}")
     return motion_from_smpl(

@@ -92,8 +92,10 @@ def attribute_command(
         raise fail(f"--target must be one of {', '.join(TARGET_KINDS)}, got '{target}'")
     if output not in OUTPUTS:
         raise fail(f"--output must be one of {', '.join(OUTPUTS)}, got '{output}'")
-    if n_steps < 1:
-        raise fail(f"--n-steps must be >= 1, got {n_steps}")
+    from gnngarment.attribution.integrated_gradients import MAX_STEPS
+
+    if not 1 <= n_steps <= MAX_STEPS:
+        raise fail(f"--n-steps must be in 1..{MAX_STEPS}, got {n_steps}")
     if heat not in HEAT_CHANNELS:  # else said only after the body and motion are built
         raise fail(f"--heat must be one of {', '.join(HEAT_CHANNELS)}, got '{heat}'")
     if scale not in SCALES:

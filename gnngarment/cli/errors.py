@@ -3,7 +3,6 @@ checks of options and garments that several commands share."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
@@ -51,9 +50,11 @@ def check_motion_options(fps: float, duration: float, motion_up_axis: str) -> No
     Raises:
         typer.Exit: (after the message) a bad value.
     """
-    for option, value in (("--fps", fps), ("--duration", duration)):
-        if not (value > 0 and math.isfinite(value)):  # also NaN, which `<= 0` lets through
-            raise fail(f"{option} must be a finite number > 0, got {value}")
+    from gnngarment.body.motion_limits import motion_option_problem
+
+    problem = motion_option_problem(fps, duration)
+    if problem is not None:
+        raise fail(problem)
     if motion_up_axis not in MOTION_UP_AXES:
         raise fail(f"--motion-up-axis must be auto, y or z, got '{motion_up_axis}'")
 

@@ -130,7 +130,7 @@ def test_model_mode_restored_and_inference_mode_caller(pair, frame) -> None:
     ({"target": "all", "target_vertices": 3}, "target 'all' takes no target_vertices"),
     ({"target_vertices": 3, "output": "weights"}, "unknown output 'weights'"),
     ({"target_vertices": 3, "reduction": "max"}, "unknown reduction 'max'"),
-    ({"target_vertices": 3, "n_steps": 0}, "n_steps must be a positive integer"),
+    ({"target_vertices": 3, "n_steps": 0}, "n_steps must be an integer in 1..1000"),
     ({"target_vertices": 3, "internal_batch_size": 0}, "internal_batch_size must be >= 1"),
 ])
 def test_bad_arguments(pair, frame, kwargs, message) -> None:

@@ -399,7 +399,7 @@ CASES: dict[str, Case] = {
         "--target must be one of"),
     "attribute-n-steps": Case(
         [*ATTRIBUTE, "--n-steps", "0"],
-        "--n-steps must be >= 1"),
+        "--n-steps must be in 1..1000"),
     "attribute-off-body": Case(
         ["attribute", "$shipped", "$far", "--out", "$new", "--n-steps", "2", "--duration", "0.2"],
         "$far: the garment is not on the rest body"),
@@ -606,3 +606,23 @@ def test_hostile_input_is_refused_in_one_line(name: str, inputs: dict[str, Path]
     for file_name, content in USER_FILES.items():
         assert (out / file_name).read_text() == content
     assert not inputs["marker"].exists(), "a pickle in an input file ran code"
+
+
+@pytest.mark.parametrize("args, expect", [
+    (["animate", "absent.obj", "--fps", "1e9"], "--fps must be at most 240"),
+    (["animate", "absent.obj", "--duration", "1e6"], "--duration must be at most 600"),
+    (["animate", "absent.obj", "--fps", "1e-6"], "fewer than 2 frames"),
+    (["animate", "absent.obj", "--duration", "1e-9"], "fewer than 2 frames"),
+    (["body", "--out", "never", "--duration", "1e5"], "--duration must be at most 600"),
+    (["attribute", "absent.pt", "absent.obj", "--out", "never", "--n-steps", "1000000000"],
+     "--n-steps must be in 1..1000"),
+])
+def test_numbers_that_ask_for_absurd_work_are_refused_first(args, expect, tmp_path,
+                                                            monkeypatch) -> None:
+    """Issue 38: these ended in MemoryError tracebacks (one after 9.8 GB) or exported a
+    single frame; each is refused by the option's name before anything is read."""
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2, result.output
+    assert expect in " ".join(result.output.split()), result.output
+    assert not (tmp_path / "never").exists()

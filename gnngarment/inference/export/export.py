@@ -158,12 +158,16 @@ def _remove_stale_frames(folder: Path, previous: tuple[int, int], first_frame: i
     kept = range(first_frame, first_frame + frames)
     # Frame numbers are zero-padded to the widest number of the export that wrote them.
     widths = {4, len(str(start + count - 1))}
-    for frame in range(start, start + count):
-        if frame in kept:
+    # Over the files that exist, not the range the manifest claims: a foreign or edited
+    # manifest claiming 10^8 frames must not make this loop for hours (issue 38).
+    for path in [*folder.glob("garment_*.obj"), *folder.glob("body_*.obj")]:
+        stem, _, digits_text = path.stem.rpartition("_")
+        if not digits_text.isdigit():
             continue
-        for stem in ("garment", "body"):
-            for digits in widths:
-                frame_path(folder, stem, frame, digits).unlink(missing_ok=True)
+        frame = int(digits_text)
+        if (start <= frame < start + count and frame not in kept and not path.is_symlink()
+                and any(frame_path(folder, stem, frame, d) == path for d in widths)):
+            path.unlink(missing_ok=True)
 
 
 def _export(animation: Animation, out: Path, name: str, formats, include_body: bool,

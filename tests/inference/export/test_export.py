@@ -177,3 +177,20 @@ def test_a_second_export_into_a_busy_folder_is_refused_and_stale_temporaries_go(
     export_animation(animation, tmp_path, "skirt", formats=("obj",))
     assert not killed.exists() and draft.read_text() == "mine"
     assert lookalike.read_text() == "mine too"
+
+
+def test_a_manifest_claiming_a_huge_export_does_not_hang_the_next_one(animation,
+                                                                       tmp_path: Path) -> None:
+    """Issue 38: a stale or foreign ``*_export.json`` claiming 10^8 frames made `animate`
+    loop until killed; the next export now looks only at the frame files that exist."""
+    import json
+
+    (tmp_path / "skirt_obj").mkdir()
+    (tmp_path / "skirt_export.json").write_text(json.dumps(
+        {"name": "skirt", "first_frame": 0, "frames": 10**8}))
+    stale = tmp_path / "skirt_obj" / "garment_5000000.obj"
+    stale.write_text("an old frame\n")
+    mine = tmp_path / "skirt_obj" / "notes_0001.obj"
+    mine.write_text("the user's\n")
+    export_animation(animation, tmp_path, "skirt", formats=("obj",))   # was: hours
+    assert not stale.exists() and mine.read_text() == "the user's\n"
