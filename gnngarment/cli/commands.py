@@ -613,6 +613,7 @@ def animate(
     from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs
     from gnngarment.geometry.errors import MeshError
     from gnngarment.geometry.mesh_io import load_mesh, load_textured_mesh
+    from gnngarment.geometry.validation import validate_mesh
     from gnngarment.inference.animate import animate as run_animation
     from gnngarment.inference.export import export_animation
     from gnngarment.inference.placement import place_garment
@@ -631,6 +632,8 @@ def animate(
     try:
         model = load_model(checkpoint, allow_unverified)
         pos, faces, uv, uv_faces = load_textured_mesh(garment_mesh)
+        # Before the placement reads the faces (an index out of range was a traceback).
+        validate_mesh(pos, faces, str(garment_mesh))
         source = None if source_body is None else load_mesh(source_body)
     except (MeshError, ValueError) as error:
         raise fail(str(error)) from None

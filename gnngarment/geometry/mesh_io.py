@@ -122,12 +122,16 @@ def _integer(word: str) -> int:
     """An OBJ index; CLOTH3D's writer prints them as floats (``6893.0``), which only a
     whole number may be."""
     try:
-        return int(word)
+        index = int(word)
     except ValueError:
         value = float(word)
         if not value.is_integer():
             raise ValueError(f"face index {word!r} is not a whole number") from None
-        return int(value)
+        index = int(value)
+    # Far beyond any file's vertex count, and beyond int64 (an OverflowError traceback).
+    if abs(index) >= 2**62:
+        raise ValueError(f"face index {word!r} is out of range")
+    return index
 
 
 def _obj_index(index: int, count: int) -> int:

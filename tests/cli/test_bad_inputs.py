@@ -125,6 +125,9 @@ def inputs(tmp_path_factory: pytest.TempPathFactory, anny_body) -> dict[str, Pat
     write("nan.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n")
     write("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n")
     write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n")
+    write("huge_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 99999999999999999999 2 3\n")
+    write("huge_float_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1e30 2 3\n")
+    write("negative_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -9 2 3\n")
     write("nofaces.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n")
     write("binary.ply", bytes(range(256)) * 8)
     write("binary.glb", b"glTF" + bytes(range(256)) * 4)
@@ -238,6 +241,17 @@ CASES: dict[str, Case] = {
     "inspect-face-range": Case(
         ["inspect", "$range_obj"],
         "$range_obj: invalid mesh: 1 faces index vertices outside 0..2"),
+    "inspect-huge-index": Case(
+        ["inspect", "$huge_index_obj"], "$huge_index_obj: cannot read OBJ file (face index"),
+    "inspect-huge-float-index": Case(
+        ["inspect", "$huge_float_index_obj"],
+        "$huge_float_index_obj: cannot read OBJ file (face index"),
+    "animate-huge-index": Case(
+        ["animate", "$huge_index_obj", "--out", "$out", "--duration", "0.2"],
+        "$huge_index_obj: cannot read OBJ file (face index"),
+    "animate-negative-index": Case(
+        ["animate", "$negative_index_obj", "--out", "$out", "--duration", "0.2"],
+        "$negative_index_obj: invalid mesh"),
     "inspect-no-faces": Case(
         ["inspect", "$nofaces_obj"],
         "$nofaces_obj: the file holds no faces"),
@@ -260,7 +274,7 @@ CASES: dict[str, Case] = {
     # ---- animate: meshes, checkpoints, motions, body shapes, options, placement --------------
     "animate-nan-mesh": Case(
         ["animate", "$nan_obj", "--out", "$out"],
-        "$nan_obj: pos contains NaN or inf"),
+        "$nan_obj: invalid mesh: 1 vertices have NaN/inf coordinates"),
     "animate-no-faces": Case(
         ["animate", "$nofaces_obj", "--out", "$out"],
         "$nofaces_obj: the file holds no faces"),
