@@ -30,7 +30,7 @@ import numpy as np
 
 from data_prep.cloth3d.errors import Cloth3DError
 from gnngarment.io.atomic import atomic_write
-from gnngarment.io.mat import MatFileError, read_mat
+from gnngarment.io.mat import MatFileError, finite_array, finite_number, read_mat, whole_number
 
 #: Fields every CLOTH3D ``info.mat`` has and :func:`read_info` / :func:`write_info` need.
 REQUIRED_FIELDS = ("poses", "trans", "shape", "gender", "zrot", "outfit")
@@ -92,12 +92,12 @@ def normalise_info(info: Mapping[str, Any], stored: bool = False) -> dict[str, A
     if len(out["poses"]) != len(out["trans"]):
         raise ValueError(f"poses has {len(out['poses'])} frames but trans has "
                          f"{len(out['trans'])}")
-    shape = np.asarray(info["shape"], dtype=np.float64)
+    shape = finite_array(info["shape"], "shape")
     if shape.ndim > 1:
         raise ValueError(f"shape has shape {shape.shape}, expected (10,) betas")
     out["shape"] = np.atleast_1d(shape)
-    out["gender"] = _integer(info["gender"], "gender")
-    out["zrot"] = _real(info["zrot"], "zrot")
+    out["gender"] = whole_number(info["gender"], "gender")
+    out["zrot"] = finite_number(info["zrot"], "zrot")
     if not isinstance(info["outfit"], Mapping):
         raise ValueError(f"outfit is a {type(info['outfit']).__name__}, expected a struct "
                          f"with one field per garment")
@@ -107,10 +107,7 @@ def normalise_info(info: Mapping[str, Any], stored: bool = False) -> dict[str, A
 
 def _frames_first(value: Any, size: int, name: str, stored: bool) -> np.ndarray:
     """``(size, T)`` (stored) or ``(T, size)`` (ours), or ``(size,)`` → ``(T, size)``."""
-    try:
-        array = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as error:
-        raise ValueError(f"{name} is not numeric ({error})") from error
+    array = finite_array(value, name)
     if array.shape == (size,):
         out = array[None, :]
     elif stored and array.ndim == 2 and array.shape[0] == size and array.shape[1] >= 1:
@@ -120,26 +117,7 @@ def _frames_first(value: Any, size: int, name: str, stored: bool) -> np.ndarray:
     else:
         expected = f"({size}, T) or ({size},)" if stored else f"(T, {size}) or ({size},)"
         raise ValueError(f"{name} has shape {array.shape}, expected {expected}")
-    if not np.isfinite(out).all():
-        raise ValueError(f"{name} contains NaN or inf")
     return np.ascontiguousarray(out)
-
-
-def _integer(value: Any, name: str) -> int:
-    array = np.asarray(value)
-    if array.size != 1 or array.dtype.kind not in "biuf" \
-            or not np.isfinite(array.astype(np.float64)).all() \
-            or float(array.item()) != int(array.item()):
-        raise ValueError(f"{name} is {value!r}, expected one integer")
-    return int(array.item())
-
-
-def _real(value: Any, name: str) -> float:
-    array = np.asarray(value)
-    if array.size != 1 or not np.issubdtype(array.dtype, np.number) \
-            or not np.isfinite(array.astype(np.float64)).all():
-        raise ValueError(f"{name} is {value!r}, expected one finite number")
-    return float(array.item())
 
 
 def write_info(path: str | Path, info: Mapping[str, Any]) -> Path:

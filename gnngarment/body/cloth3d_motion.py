@@ -11,11 +11,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 from gnngarment.body.motion import Motion, MotionError
 from gnngarment.body.smpl_motion import motion_from_smpl
-from gnngarment.io.mat import MatFileError, read_mat
+from gnngarment.io.mat import MatFileError, finite_array, finite_number, read_mat
 
 __all__ = ["load_cloth3d_motion", "read_cloth3d_info"]
 
@@ -43,6 +41,10 @@ def load_cloth3d_motion(
     """A CLOTH3D sequence's motion from its ``info.mat``: ``poses`` (72, T) or (72,),
     ``trans`` (3, T) or (3,), ``zrot`` (radians).
 
+    Raises:
+        MotionError: naming the file and the field: a field missing, not numeric (a
+            string, struct or cell array), holding NaN/inf, or of the wrong shape.
+
     Args:
         fps: CLOTH3D stores no frame rate; 30 fps is the usual assumption.
         apply_zrot: rotate the motion about world Z by ``zrot`` (root orientation and
@@ -54,13 +56,17 @@ def load_cloth3d_motion(
     for key in ("poses", "trans"):
         if key not in info:
             raise MotionError(f"{path}: info.mat has no '{key}' field")
-    poses = np.asarray(info["poses"], dtype=np.float64)
-    trans = np.asarray(info["trans"], dtype=np.float64)
+    try:
+        poses = finite_array(info["poses"], "poses")
+        trans = finite_array(info["trans"], "trans")
+        zrot = finite_number(info.get("zrot", 0.0), "zrot") if apply_zrot else 0.0
+    except ValueError as error:
+        raise MotionError(f"{path}: {error}") from None
     if poses.shape == (72,):
         poses = poses[:, None]
     if trans.shape == (3,):
         trans = trans[:, None]
-    if poses.ndim != 2 or poses.shape[0] != 72:
+    if poses.ndim != 2 or poses.shape[0] != 72 or poses.shape[1] < 1:
         raise MotionError(f"{path}: 'poses' must be (72, T), got {poses.shape}")
     if trans.shape != (3, poses.shape[1]):
         raise MotionError(f"{path}: 'trans' must be (3, {poses.shape[1]}), got {trans.shape}")
@@ -68,7 +74,6 @@ def load_cloth3d_motion(
         poses.T, trans.T, fps, str(path), relative_translation=relative_translation
     )
     if apply_zrot:
-        zrot = float(np.asarray(info.get("zrot", 0.0)))
         rz = Rotation.from_rotvec([0.0, 0.0, zrot])
         rotations = motion.rotations.copy()
         rotations[:, 0] = (rz * Rotation.from_rotvec(rotations[:, 0])).as_rotvec()

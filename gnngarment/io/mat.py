@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["MatFileError", "read_mat"]
+__all__ = ["MatFileError", "finite_array", "finite_number", "read_mat", "whole_number"]
 
 
 class MatFileError(ValueError):
@@ -63,3 +63,59 @@ def plain_value(value: Any) -> Any:
     if isinstance(value, np.generic):
         return value.item()
     return value
+
+
+def finite_array(value: Any, name: str) -> np.ndarray:
+    """A numeric variable (or struct field) as a float64 array, every element finite.
+
+    Raises:
+        ValueError: ``value`` is a string, a struct (dict), a cell array (list) or an
+            array of a non-numeric type, or holds NaN/inf; the message names ``name``.
+    """
+    if isinstance(value, (str, bytes, dict)):
+        raise ValueError(f"{name} is a {_kind(value)}, expected numbers")
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError) as error:  # a ragged cell array
+        raise ValueError(f"{name} is not numeric ({error})") from None
+    if array.dtype.kind not in "biuf":
+        raise ValueError(f"{name} is a {_kind(value)}, expected numbers")
+    array = array.astype(np.float64)
+    if not np.isfinite(array).all():
+        raise ValueError(f"{name} contains NaN or inf")
+    return array
+
+
+def finite_number(value: Any, name: str) -> float:
+    """One finite number (a MATLAB scalar or a one-element array).
+
+    Raises:
+        ValueError: not numeric, not one element, or not finite.
+    """
+    array = finite_array(value, name)
+    if array.size != 1:
+        raise ValueError(f"{name} has shape {array.shape}, expected one number")
+    return float(array.item())
+
+
+def whole_number(value: Any, name: str) -> int:
+    """One integer (MATLAB stores integers as doubles, so ``1.0`` counts).
+
+    Raises:
+        ValueError: not one finite number, or not a whole one.
+    """
+    number = finite_number(value, name)
+    if number != int(number):
+        raise ValueError(f"{name} is {number!r}, expected one integer")
+    return int(number)
+
+
+def _kind(value: Any) -> str:
+    """What a value read from a ``.mat`` file is, in MATLAB's words."""
+    if isinstance(value, (str, bytes)):
+        return f"string ({value!r:.40})"
+    if isinstance(value, dict):
+        return "struct"
+    if isinstance(value, list):
+        return "cell array"
+    return f"{np.asarray(value).dtype} array"

@@ -165,6 +165,16 @@ def inputs(tmp_path_factory: pytest.TempPathFactory, anny_body) -> dict[str, Pat
     np.savez(folder / "wrong.npz", poses=np.zeros((4, 70)), trans=np.zeros((4, 3)),
              mocap_framerate=np.array(30.0))
     paths["wrong_npz"] = folder / "wrong.npz"
+    # CLOTH3D info.mat files whose fields have the wrong types (issue 38).
+    import scipy.io
+
+    mat_fields = {"poses": np.zeros((72, 4)), "trans": np.zeros((3, 4)), "zrot": 0.0}
+    for name, change in {"poses_string": {"poses": "abc"}, "poses_struct": {"poses": {"a": 1}},
+                         "trans_cell": {"trans": np.array(["a", "b"], dtype=object)},
+                         "poses_nan": {"poses": np.full((72, 4), np.nan)}}.items():
+        (folder / name).mkdir()
+        scipy.io.savemat(folder / name / "info.mat", {**mat_fields, **change})
+        paths[f"{name}_mat"] = folder / name / "info.mat"
     write("map.json", json.dumps({"L_hipp": "LeftUpLeg"}))
     write("shape_key.json", json.dumps({"heigth": 0.5}))
     write("shape_list.json", json.dumps([0.5, 0.5]))
@@ -318,6 +328,18 @@ CASES: dict[str, Case] = {
     "animate-npz-wrong-shape": Case(
         [*ANIMATE, "--motion", "$wrong_npz"],
         "$wrong_npz: 'poses' must be (T, 72|156|165), got (4, 70)"),
+    "animate-mat-poses-string": Case(
+        [*ANIMATE, "--motion", "$poses_string_mat"],
+        "$poses_string_mat: poses is a string ('abc'), expected numbers"),
+    "animate-mat-poses-struct": Case(
+        [*ANIMATE, "--motion", "$poses_struct_mat"],
+        "$poses_struct_mat: poses is a struct, expected numbers"),
+    "animate-mat-trans-cell": Case(
+        [*ANIMATE, "--motion", "$trans_cell_mat"],
+        "$trans_cell_mat: trans is a cell array, expected numbers"),
+    "animate-mat-poses-nan": Case(
+        [*ANIMATE, "--motion", "$poses_nan_mat"],
+        "$poses_nan_mat: poses contains NaN or inf"),
     "animate-joint-map-unknown": Case(
         [*ANIMATE, "--motion", "$clip_bvh", "--joint-map", "$map_json"],
         "$map_json: joint map key 'L_hipp' is not a canonical"),

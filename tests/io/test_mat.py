@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gnngarment.io.mat import MatFileError, read_mat
+from gnngarment.io.mat import MatFileError, finite_array, finite_number, read_mat, whole_number
 
 
 def test_structs_cells_scalars_and_strings_come_back_plain(tmp_path) -> None:
@@ -33,3 +33,26 @@ def test_missing_and_broken_files_are_named(tmp_path) -> None:
     path.write_bytes(b"MATLAB 5.0 MAT-file" + bytes(100))
     with pytest.raises(MatFileError, match=f"{path}: cannot read MAT file"):
         read_mat(path)
+
+
+@pytest.mark.parametrize(("value", "message"), [
+    ("abc", "poses is a string .'abc'., expected numbers"),
+    ("1.5", "poses is a string"),  # numpy would parse it as a float
+    ({"a": 1}, "poses is a struct, expected numbers"),
+    (["a", 1.0], "poses is a cell array, expected numbers"),
+    (np.array(["a", "b"], dtype=object), "poses is a object array, expected numbers"),
+    (np.array([1.0, np.nan]), "poses contains NaN or inf"),
+])
+def test_values_of_the_wrong_type_are_named(value, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        finite_array(value, "poses")
+
+
+def test_numbers_and_integers() -> None:
+    assert finite_array([1, 2], "x").dtype == np.float64
+    assert finite_number(np.array([0.5]), "zrot") == 0.5
+    assert whole_number(1.0, "gender") == 1
+    with pytest.raises(ValueError, match="zrot has shape .2,., expected one number"):
+        finite_number([1.0, 2.0], "zrot")
+    with pytest.raises(ValueError, match="gender is 0.5, expected one integer"):
+        whole_number(0.5, "gender")
