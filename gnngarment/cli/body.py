@@ -86,6 +86,12 @@ def body_command(
             **({} if Path(motion).suffix else {"duration": duration, "seed": seed}))
     except MotionError as error:
         raise fail(str(error)) from None
+    if motion_data is not None:
+        from gnngarment.inference.animation_memory import animation_memory_problem
+
+        problem = animation_memory_problem(motion_data.num_frames, garment_vertices=0)
+        if problem:
+            raise fail(problem)
     try:
         with console.status(f"loading the {model} body model (first Anny run builds a cache)"):
             body = create_body_model(BodyConfig(model=model, smpl_model_path=smpl_path))

@@ -615,6 +615,7 @@ def animate(
     from gnngarment.geometry.mesh_io import load_mesh, load_textured_mesh
     from gnngarment.geometry.validation import validate_mesh
     from gnngarment.inference.animate import animate as run_animation
+    from gnngarment.inference.animation_memory import animation_memory_problem
     from gnngarment.inference.export import export_animation
     from gnngarment.inference.placement import place_garment
     from gnngarment.model.checkpoint import load_model
@@ -640,6 +641,11 @@ def animate(
     body_model, shape, motion_value = _load_body_and_motion(body_shape, motion, fps, duration,
                                                             joint_map, motion_up_axis,
                                                             lead_in_seconds)
+    # Before the drape and the inference: frames x vertices can exceed the free memory
+    # even with each option within its limit.
+    problem = animation_memory_problem(len(motion_value), len(pos))
+    if problem:
+        raise fail(problem)
     body_inputs = body_shape_inputs(body_model, shape, model.config.body_vertices)
     try:
         placed = place_garment(pos, faces, body_inputs, units=fix_units, up_axis=up_axis,

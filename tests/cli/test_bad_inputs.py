@@ -662,3 +662,21 @@ def test_numbers_that_ask_for_absurd_work_are_refused_first(args, expect, tmp_pa
     assert result.exit_code == 2, result.output
     assert expect in " ".join(result.output.split()), result.output
     assert not (tmp_path / "never").exists()
+
+
+def test_an_animation_larger_than_the_free_memory_is_refused_before_the_work(
+        inputs, tmp_path, monkeypatch) -> None:
+    """Issue 38: frames x vertices within each option's limit can still exceed the
+    machine (600 s at 240 fps of a 5,000-vertex dress: ~545 GB); refused by the options
+    that set the frame count, before the drape or the inference, with no output folder."""
+    from gnngarment.inference import animation_memory
+
+    monkeypatch.setattr(animation_memory, "available_bytes", lambda: 50e6)  # 50 MB free
+    out = tmp_path / "never"
+    result = runner.invoke(app, ["animate", str(inputs["skirt"]), "--out", str(out),
+                                 "--duration", "2"])
+    text = " ".join(result.output.split())
+    assert result.exit_code == 2, result.output
+    assert "more than this machine has free (0.1 GB available)" in text, text
+    assert "--duration" in text and "--fps" in text
+    assert not out.exists()
