@@ -23,23 +23,100 @@ class ConfigError(ValueError):
 MAPPING_SUFFIXES = (".json", ".yaml", ".yml")
 
 
-def parse_mapping_text(text: str, suffix: str) -> Any:
+#: Most values a YAML document may expand to (aliases counted each time they are used):
+#: a "billion laughs" file of a few lines expands to millions.
+MAX_YAML_VALUES = 100_000
+#: Deepest nesting of a YAML document (our configs nest three levels).
+MAX_YAML_DEPTH = 64
+
+
+def parse_yaml(text: str, source: str) -> Any:
+    """The value of a YAML document, as plain Python (dicts, lists, scalars), read safely:
+    no tags that build objects (``!!python/...``), no duplicate keys, at most
+    :data:`MAX_YAML_DEPTH` levels and :data:`MAX_YAML_VALUES` values after alias
+    expansion.
+
+    Raises:
+        ConfigError: one line naming ``source`` (the file), the problem and its line.
+    """
+    import yaml
+
+    class StrictLoader(yaml.SafeLoader):
+        """SafeLoader that refuses a key given twice (PyYAML keeps the last)."""
+
+        def construct_mapping(self, node, deep=False):  # type: ignore[no-untyped-def]
+            seen: dict[Any, Any] = {}
+            for key_node, _ in node.value:
+                key = self.construct_object(key_node, deep=deep)
+                if key in seen:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"duplicate key '{key}'", key_node.start_mark)
+                seen[key] = True
+            return super().construct_mapping(node, deep=deep)
+
+    try:
+        value = yaml.load(text, Loader=StrictLoader)  # a SafeLoader subclass: no object tags
+    except yaml.MarkedYAMLError as error:
+        problem = error.problem or error.context or "invalid YAML"
+        mark = error.problem_mark or error.context_mark
+        where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark else ""
+        if problem.startswith("could not determine a constructor"):
+            problem = "a tag that would build an object is not allowed " + problem[
+                problem.find("for the tag"):].removeprefix("for the tag ")
+        raise ConfigError(f"{source}: not a valid YAML file: {problem}{where}") from None
+    except yaml.YAMLError as error:
+        raise ConfigError(f"{source}: not a valid YAML file: "
+                          f"{str(error).splitlines()[0]}") from None
+    except RecursionError:
+        raise ConfigError(f"{source}: YAML nested too deeply "
+                          f"(at most {MAX_YAML_DEPTH} levels)") from None
+    _check_yaml_size(value, source)
+    return value
+
+
+def _check_yaml_size(value: Any, source: str) -> None:
+    """Walk the expanded document with a budget (aliases share objects, so the walk
+    counts what a copy would build) and refuse one too deep or too large."""
+    budget = MAX_YAML_VALUES
+    stack = [(value, 1)]
+    while stack:
+        item, depth = stack.pop()
+        budget -= 1
+        if budget < 0:
+            raise ConfigError(f"{source}: YAML expands to more than {MAX_YAML_VALUES:,} "
+                              "values (aliases repeated inside aliases?)")
+        if depth > MAX_YAML_DEPTH:
+            raise ConfigError(f"{source}: YAML nested too deeply "
+                              f"(at most {MAX_YAML_DEPTH} levels)")
+        if isinstance(item, dict):
+            stack.extend((child, depth + 1) for pair in item.items() for child in pair)
+        elif isinstance(item, list):
+            stack.extend((child, depth + 1) for child in item)
+
+
+def parse_mapping_text(text: str, suffix: str, source: str = "<text>") -> Any:
     """The value of a small user file (a body shape, a joint map): JSON for ``.json``,
-    YAML (OmegaConf, no code execution) for ``.yaml``/``.yml``.
+    YAML (:func:`parse_yaml`: no code execution, no duplicate keys) for ``.yaml``/``.yml``.
 
     Raises:
         KeyError: ``suffix`` is not one of :data:`MAPPING_SUFFIXES`.
-        Exception: the parser's own syntax error (callers name their file).
+        ConfigError: a YAML problem, naming ``source``.
+        ValueError: a JSON syntax error or duplicate key (callers name their file).
     """
     import json
 
     suffix = suffix.lower()
     if suffix == ".json":
-        return json.loads(text)
-    if suffix in (".yaml", ".yml"):
-        from omegaconf import OmegaConf
+        def refuse_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+            keys = [key for key, _ in pairs]
+            repeated = sorted({key for key in keys if keys.count(key) > 1})
+            if repeated:
+                raise ValueError(f"duplicate key(s) {repeated}")
+            return dict(pairs)
 
-        return OmegaConf.to_container(OmegaConf.create(text))
+        return json.loads(text, object_pairs_hook=refuse_duplicates)
+    if suffix in (".yaml", ".yml"):
+        return parse_yaml(text, source)
     raise KeyError(suffix)
 
 
@@ -56,9 +133,18 @@ def read_yaml(path: str | Path) -> Any:
     if not path.is_file():
         raise ConfigError(f"{path}: config file not found")
     try:
-        return OmegaConf.load(path)
-    except Exception as error:  # yaml.YAMLError and friends
-        raise ConfigError(f"{path}: not a valid YAML file ({error})") from error
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        raise ConfigError(f"{path}: cannot read the config file ({error})") from None
+    value = parse_yaml(text, str(path))
+    if value is not None and not isinstance(value, (dict, list)):
+        # OmegaConf.create would parse a string as YAML text again.
+        raise ConfigError(f"{path}: expected a mapping of settings, got a "
+                          f"{type(value).__name__}")
+    try:
+        return OmegaConf.create(value if value is not None else {})
+    except Exception as error:  # a scalar document, a key OmegaConf cannot hold
+        raise ConfigError(f"{path}: not a config ({str(error).splitlines()[0]})") from None
 
 
 def load_config(path: str | Path, schema: type[T], section: str | None = None) -> T:

@@ -79,14 +79,16 @@ class AnnyShape:
         path = Path(path)
         if not path.is_file():
             raise ValueError(f"{path}: shape file not found")
-        from gnngarment.config import MAPPING_SUFFIXES, parse_mapping_text
+        from gnngarment.config import MAPPING_SUFFIXES, ConfigError, parse_mapping_text
 
         if path.suffix.lower() not in MAPPING_SUFFIXES:
             raise ValueError(f"{path}: unknown shape file type (expected .json, .yaml or .yml)")
         text = path.read_text()
         try:
-            values = parse_mapping_text(text, path.suffix)
-        except Exception as error:  # yaml/json syntax errors
+            values = parse_mapping_text(text, path.suffix, str(path))
+        except ConfigError as error:  # names the file already
+            raise ValueError(str(error)) from None
+        except Exception as error:  # json syntax errors
             raise ValueError(f"{path}: cannot parse ({error})") from error
         if not isinstance(values, dict):
             raise ValueError(f"{path}: expected a mapping of phenotype values")

@@ -175,14 +175,16 @@ def read_joint_map(path: str | Path) -> dict[str, str | None]:
     path = Path(path)
     if not path.is_file():
         raise MotionError(f"{path}: joint map file not found")
-    from gnngarment.config import MAPPING_SUFFIXES, parse_mapping_text
+    from gnngarment.config import MAPPING_SUFFIXES, ConfigError, parse_mapping_text
 
     if path.suffix.lower() not in MAPPING_SUFFIXES:
         raise MotionError(f"{path}: joint map must be a .json, .yaml or .yml file")
     text = path.read_text(errors="replace")
     try:
-        values = parse_mapping_text(text, path.suffix)
-    except Exception as error:  # json / yaml syntax errors
+        values = parse_mapping_text(text, path.suffix, str(path))
+    except ConfigError as error:  # names the file already
+        raise MotionError(str(error)) from None
+    except Exception as error:  # json syntax errors
         message = " ".join(str(error).split())
         raise MotionError(f"{path}: not a readable joint map ({message})") from error
     return _check_joint_map(values, str(path))

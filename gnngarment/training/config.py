@@ -11,9 +11,18 @@ from gnngarment.model.config import ModelConfig
 TRAINED_STAGES = ("supervised", "physics", "physics_strain")
 
 
-def _check_at_least(key: str, value: int, low: int) -> None:
+def _check_at_least(key: str, value: int, low: int, high: int | None = None) -> None:
     if value < low:
         raise ValueError(f"key '{key}': must be >= {low}, got {value}")
+    if high is not None and value > high:
+        raise ValueError(f"key '{key}': must be <= {high:,}, got {value:,}")
+
+
+#: Upper bounds of the training sizes (docs/reliability.md "Resource limits"): far above
+#: any recipe (the paper's batch is 4 pairs x 16 frames), below what exhausts memory
+#: before the first step (``pairs_per_batch: 1e9`` ran).
+TRAINING_SIZE_LIMITS = {"seed": 2**32 - 1, "epochs": 100_000, "pairs_per_batch": 256,
+                        "frames_per_pair": 256, "threads": 1024, "validate_every": 100_000}
 
 
 def _check_finite(key: str, value: float, positive: bool = False) -> None:
@@ -123,7 +132,7 @@ class TrainingConfig:
         """
         for key, low in (("seed", 0), ("epochs", 1), ("pairs_per_batch", 1),
                          ("frames_per_pair", 1), ("threads", 0), ("validate_every", 1)):
-            _check_at_least(key, getattr(self, key), low)
+            _check_at_least(key, getattr(self, key), low, TRAINING_SIZE_LIMITS[key])
         _check_finite("learning_rate", self.learning_rate, positive=True)
         _check_finite("collision_margin", self.collision_margin)
         for item in fields(self.losses):

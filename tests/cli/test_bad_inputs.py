@@ -234,6 +234,11 @@ ATTRIBUTE = ["attribute", "$shipped", "$skirt", "--out", "$out", "--n-steps", "2
              "--duration", "0.2"]
 EVALUATE = ["evaluate", "--checkpoint", "$tiny", "--data", "$cache", "--no-spurious"]
 
+#: Nine aliases to nine aliases ... six levels deep: 9**6 values once expanded.
+ALIAS_BOMB = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
+    f"{name}: &{name} [{', '.join(['*' + inner] * 9)}]\n"
+    for inner, name in zip("abcde", "bcdef", strict=True))
+
 CASES: dict[str, Case] = {
     # ---- inspect: garment meshes and configs -------------------------------------------------
     "inspect-missing": Case(
@@ -509,6 +514,40 @@ CASES: dict[str, Case] = {
         ["train", "--config", "$work/t.yaml", "--set", "epochs"],
         "(with --set epochs): key 'epochs'",
         {"t.yaml": TRAIN}),
+    "train-set-too-large": Case(
+        ["train", "--config", "$work/t.yaml", "--set", "pairs_per_batch=1000000000"],
+        "key 'pairs_per_batch': must be <= 256, got 1,000,000,000",
+        {"t.yaml": TRAIN}),
+    # YAML that is valid to a lax parser but not a config (issue 38): one line each.
+    "train-yaml-duplicate-key": Case(
+        ["train", "--config", "$work/t.yaml"],
+        "$work/t.yaml: not a valid YAML file: duplicate key 'epochs' (line",
+        {"t.yaml": TRAIN + "epochs: 2\n"}),
+    "train-yaml-alias-bomb": Case(
+        ["train", "--config", "$work/t.yaml"],
+        "$work/t.yaml: YAML expands to more than 100,000 values",
+        {"t.yaml": ALIAS_BOMB}),
+    "train-yaml-python-tag": Case(
+        ["train", "--config", "$work/t.yaml"],
+        "$work/t.yaml: not a valid YAML file: a tag that would build an object is not "
+        "allowed",
+        {"t.yaml": TRAIN + "seed: !!python/object/apply:os.system [touch $work/ran]\n"}),
+    "train-yaml-deep": Case(
+        ["train", "--config", "$work/t.yaml"],
+        "$work/t.yaml: YAML nested too deeply (at most 64 levels)",
+        {"t.yaml": "a: " + "[" * 4000 + "]" * 4000 + "\n"}),
+    "body-shape-yaml-duplicate-key": Case(
+        [*BODY, "--shape", "$work/s.yaml"],
+        "$work/s.yaml: not a valid YAML file: duplicate key 'height' (line 2, column 1)",
+        {"s.yaml": "height: 0.5\nheight: 0.6\n"}),
+    "body-shape-yaml-string": Case(
+        [*BODY, "--shape", "$work/s.yaml"],
+        "$work/s.yaml: expected a mapping of phenotype values",
+        {"s.yaml": "just a string\n"}),
+    "body-shape-json-duplicate-key": Case(
+        [*BODY, "--shape", "$work/s.json"],
+        "duplicate key(s) ['height']",
+        {"s.json": '{"height": 0.5, "height": 0.6}'}),
     # ---- evaluate ----------------------------------------------------------------------------
     "evaluate-json-folder": Case(
         [*EVALUATE, "--json", "$out"],
