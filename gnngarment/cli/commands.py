@@ -289,6 +289,15 @@ def prepare(
         report = build_dataset(settings, workers=workers, log=console.print)
     except (RayMissingError, ValueError, OSError) as error:
         raise fail(str(error)) from None
+    if report["planned"] and not sum(report["splits"].values()):
+        # Every sequence failed (motion_seconds: 1e9 hit an allocation in each): an empty
+        # cache is not a build; the reasons are in the report.
+        reasons = ", ".join(f"{count} {kind}" for kind, count in
+                            (report.get("losses_by_reason") or {}).items()
+                            if kind not in ("planned", "lost"))
+        raise fail(f"{report['output']}: every one of the {report['planned']} planned "
+                   f"sequences was left out ({reasons or 'no reason recorded'}; "
+                   f"{report['output']}/build_report.json lists each)")
     console.print(f"[green]done[/] in {report['seconds']:.0f} s: splits {report['splits']}, "
                   f"{len(report['failed_sequences'])} sequence(s) left out; "
                   f"cache in {report['output']}")
@@ -450,10 +459,13 @@ def _export_name(garment_mesh: Path) -> str:
 
 def _refuse_outputs_over_inputs(out: Path, name: str, formats: list[str], include_body: bool,
                                 inputs: list[Path | None]) -> None:
-    from gnngarment.inference.export.export import export_paths
+    from gnngarment.inference.export.export import export_paths, listed_export_files
     from gnngarment.inference.output_folder import check_outputs_spare_inputs
 
     files, folders = export_paths(out, name, formats, include_body)
+    # An earlier export's files that this one does not write are removed by it.
+    for path in listed_export_files(out, name):
+        (folders if path.name == f"{name}_obj" else files).append(path)
     try:
         check_outputs_spare_inputs(files, folders, [p for p in inputs if p is not None])
     except ValueError as error:

@@ -65,8 +65,8 @@ def check_outputs_spare_inputs(files: list[Path], folders: list[Path],
         for output in files:
             target = output.resolve()
             if target == source or (output.exists() and os.path.samefile(output, given)):
-                raise ValueError(f"{given}: the output {output} would overwrite this input "
-                                 "(choose another --out folder)")
+                raise ValueError(f"{given}: the output {output} would overwrite (or remove) "
+                                 "this input (choose another --out folder)")
         for folder in folders:
             if source.is_relative_to(folder.resolve()):
                 raise ValueError(f"{given}: this input lies in {folder}, whose files the "

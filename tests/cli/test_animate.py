@@ -336,7 +336,7 @@ def animate_args(garment: Path, checkpoint: Path, out: Path, formats: str = "glb
 
 
 @pytest.mark.parametrize("place", ["the export's own name", "a symlink to the input",
-                                   "the OBJ sequence folder"])
+                                   "the OBJ sequence folder", "an earlier export's file"])
 def test_an_output_never_overwrites_the_input_garment(files, tmp_path: Path, place) -> None:
     """Issue 38: `animate OUT/skirt.glb --out OUT --format glb` replaced the user's garment
     with its own result. Refused before any work, the input as it was."""
@@ -350,10 +350,14 @@ def test_an_output_never_overwrites_the_input_garment(files, tmp_path: Path, pla
         garment, formats = tmp_path / "skirt.obj", "pc2"
         skirt.export(garment)
         (out / "skirt_rest.obj").symlink_to(garment)   # what pc2 writes beside it
-    else:
+    elif place == "the OBJ sequence folder":
         garment, formats = out / "skirt_obj" / "skirt.obj", "obj"
         garment.parent.mkdir()
         skirt.export(garment)
+    else:  # an export of ours wrote skirt.glb; a pc2 export would remove it as stale
+        garment, formats = out / "skirt.glb", "pc2"
+        skirt.export(garment)
+        (out / "skirt_export.json").write_text('{"files": {"glb": "skirt.glb"}}')
     before = garment.read_bytes()
     result = runner.invoke(app, animate_args(garment, files["checkpoint"], out, formats))
     assert result.exit_code == 2, result.output

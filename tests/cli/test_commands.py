@@ -201,3 +201,23 @@ def test_evaluate_refuses_a_mismatched_checkpoint_and_unusable_outputs_up_front(
         assert result.exit_code == 2, (arguments, result.output)
         text = " ".join(result.output.split())
         assert message in text and "Traceback" not in text, text
+
+
+def test_a_build_that_loses_every_sequence_exits_non_zero(tmp_path, monkeypatch) -> None:
+    """Issue 38: `prepare` whose every sequence failed (motion_seconds: 1e9 hit an
+    allocation in each) exited 0 with an empty cache; it now says so and exits 2."""
+    import data_prep.build
+
+    def build_nothing(settings, workers=None, log=print):
+        return {"output": settings.output, "seconds": 1.0, "planned": 3,
+                "splits": {"train": 0, "val": 0, "test": 0},
+                "failed_sequences": {"a": "x", "b": "y", "c": "z"},
+                "losses_by_reason": {"planned": 3, "lost": 3, "memory": 3}}
+
+    monkeypatch.setattr(data_prep.build, "build_dataset", build_nothing)
+    config = tmp_path / "data.yaml"
+    config.write_text(f"output: {tmp_path / 'cache'}\n")
+    result = runner.invoke(app, ["prepare", "--config", str(config)])
+    text = " ".join(result.output.split())
+    assert result.exit_code == 2, result.output
+    assert "every one of the 3 planned sequences was left out (3 memory;" in text, text

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable, Sequence
-from contextlib import nullcontext
+from contextlib import nullcontext, suppress
 from numbers import Integral
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -96,18 +96,51 @@ def export_animation(animation: Animation, out_dir: str | Path, name: str,
         raise ValueError(f"the lock given is on {lock.folder}, not on {out}")
     with nullcontext(lock) if lock is not None else FolderLock(out, "export") as lock:
         lock.remove_stale_temporaries((".", f"{name}_obj"))
-        previous = _previous_frames(out / f"{name}_export.json")
-        if "obj" in formats:
-            # Until this export ends, its manifest says which frames may be on disk (the
-            # previous export's and this one's): an export killed part-way leaves frames
-            # the next one then knows to remove.
-            _write_pending_manifest(out / f"{name}_export.json", name, previous,
-                                    first_frame, len(animation.posed))
+        manifest = out / f"{name}_export.json"
+        previous = _previous_frames(manifest)
+        previous_files = {path.name for path in listed_export_files(out, name)}
+        files, folders = export_paths(out, name, formats, include_body)
+        writing = {path.name for path in [*files, *folders]}
+        # Until this export ends, its manifest says which frames and files may be on disk
+        # (the previous export's and this one's): an export killed part-way leaves what
+        # the next one then knows to remove.
+        _write_pending_manifest(manifest, name, previous, first_frame, len(animation.posed),
+                                sorted(previous_files | writing))
         paths = _export(animation, out, name, formats, include_body, progress, first_frame,
                         max_influences, morph_interpolation, preview_size, preview_max_frames)
         if "obj" in formats and previous is not None:
             _remove_stale_frames(paths["obj"], previous, first_frame, len(animation.posed))
+        # What an earlier export of ours (by its manifest) wrote and this one did not: a
+        # killed run's skirt.glb must not sit beside a new, shorter export without one.
+        for stale in sorted(previous_files - writing):
+            path = out / stale
+            if path.is_symlink():
+                continue
+            if path.is_dir():
+                if previous is not None:
+                    _remove_stale_frames(path, previous, 0, 0)
+                with suppress(OSError):  # not empty: holds something we did not write
+                    path.rmdir()
+            elif path.is_file():
+                path.unlink(missing_ok=True)
     return paths
+
+
+def listed_export_files(out_dir: str | Path, name: str) -> list[Path]:
+    """The files and folders the earlier export in ``out_dir`` lists in its manifest
+    (also one killed part-way), kept only where they are names an export of ``name``
+    would use (a foreign manifest cannot point elsewhere). The next export removes those
+    it does not write itself, so a command checks its inputs against them too."""
+    out = Path(out_dir)
+    manifest = out / f"{name}_export.json"
+    try:
+        listed = json.loads(manifest.read_text())["files"]
+        names = set(listed.values() if isinstance(listed, dict) else listed)
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return []
+    files, folders = export_paths(out, name, FORMATS, include_body=True)
+    ours = {path.name for path in [*files, *folders]} - {manifest.name}
+    return [out / item for item in sorted(i for i in names if isinstance(i, str)) if item in ours]
 
 
 def export_paths(out_dir: str | Path, name: str, formats: Sequence[str], include_body: bool
@@ -139,14 +172,16 @@ def _previous_frames(manifest: Path) -> tuple[int, int] | None:
 
 
 def _write_pending_manifest(manifest: Path, name: str, previous: tuple[int, int] | None,
-                            first_frame: int, frames: int) -> None:
+                            first_frame: int, frames: int, files: list[str]) -> None:
     """The manifest of an export in progress: the frame range covering the previous
-    export's frames and this one's (replaced by the full manifest at the end)."""
+    export's frames and this one's, and the files of both (replaced by the full manifest
+    at the end)."""
     start, end = first_frame, first_frame + frames
     if previous is not None:
         start, end = min(start, previous[0]), max(end, previous[0] + previous[1])
     atomic_write_bytes(manifest, json.dumps({
         "name": name, "first_frame": start, "frames": end - start, "in_progress": True,
+        "files": files,
     }, indent=2).encode())
 
 

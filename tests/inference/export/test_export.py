@@ -194,3 +194,44 @@ def test_a_manifest_claiming_a_huge_export_does_not_hang_the_next_one(animation,
     mine.write_text("the user's\n")
     export_animation(animation, tmp_path, "skirt", formats=("obj",))   # was: hours
     assert not stale.exists() and mine.read_text() == "the user's\n"
+
+
+def test_files_of_a_killed_export_in_other_formats_do_not_stay_beside_a_new_one(
+        animation, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 38: a killed `--format obj,pc2,glb` run left its skirt.glb beside the
+    re-run's `--format obj,pc2` export. The pending manifest records the files an export
+    is about to write; the next export removes those it does not write itself. Files
+    the manifest does not list, or that are not named as ours, stay."""
+    import gnngarment.inference.export.export as export_module
+
+    real_write_obj_sequence = export_module.write_obj_sequence
+
+    def killed(*args, **kwargs):  # the glb and pc2 are written, then the run dies
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(export_module, "write_obj_sequence", killed)
+    with pytest.raises(KeyboardInterrupt):
+        export_animation(animation, tmp_path, "skirt", formats=("obj", "pc2", "glb"))
+    assert (tmp_path / "skirt.glb").is_file()
+    monkeypatch.setattr(export_module, "write_obj_sequence", real_write_obj_sequence)
+    (tmp_path / "skirt_notes.glb").write_text("mine")
+    export_animation(animation, tmp_path, "skirt", formats=("obj", "pc2"))
+    assert not (tmp_path / "skirt.glb").exists()
+    assert (tmp_path / "skirt.pc2").is_file() and (tmp_path / "skirt_notes.glb").exists()
+    # And an OBJ sequence goes when the next export writes none.
+    export_animation(animation, tmp_path, "skirt", formats=("pc2",))
+    assert not (tmp_path / "skirt_obj").exists()
+    manifest = json.loads((tmp_path / "skirt_export.json").read_text())
+    assert set(manifest["files"].values()) == {"skirt.pc2", "skirt_rest.obj",
+                                                "skirt_body.pc2", "skirt_body.obj"}
+
+
+def test_a_foreign_manifest_cannot_name_files_outside_our_export(animation,
+                                                                  tmp_path: Path) -> None:
+    user = tmp_path / "thesis.tex"
+    user.write_text("mine")
+    (tmp_path / "skirt_export.json").write_text(json.dumps(
+        {"name": "skirt", "first_frame": 0, "frames": 4,
+         "files": ["thesis.tex", "../outside.txt", "skirt.glb"]}))
+    export_animation(animation, tmp_path, "skirt", formats=("pc2",))
+    assert user.read_text() == "mine"
