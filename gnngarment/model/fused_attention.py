@@ -24,8 +24,10 @@ ninja, which ``torch.utils.cpp_extension.load`` requires and a fresh machine may
 Any failure (no compiler, a compile error, a library that does not load) leaves the
 PyTorch path in use, and :func:`attention_path` says why.
 
-``GNNGARMENT_ATTENTION=pytorch`` forces the PyTorch path (read at each call, not at
-import), ``fused`` or ``auto`` (the default) use the operator when it is available;
+``GNNGARMENT_ATTENTION`` (read at each call, not at import) picks the path: ``pytorch``
+always the reference; ``fused`` the operator wherever it is available; ``auto`` (the
+default) the operator for inference, and where autograd records the forward the path
+:data:`AUTO_UNDER_AUTOGRAD` names (the one measured faster in training).
 :func:`use_attention_path` does the same for a block of code.
 
 Shapes follow :class:`~gnngarment.model.graph_attention.GraphAttention`.
@@ -63,6 +65,10 @@ PATHS = ("fused", "pytorch")
 #: Flags tried in turn: the CPU's own instructions first, portable code if the compiler
 #: does not know ``-march=native``.
 _ARCH_FLAGS = (["-march=native"], [])
+#: What ``auto`` uses where autograd records the forward (training): on the shipped
+#: training recipe the fused path measured 1.12-1.31x (supervised) and 0.98-1.10x
+#: (physics stages) the PyTorch path's steps/s (docs/performance.md, "Fused attention").
+AUTO_UNDER_AUTOGRAD = "fused"
 #: Seconds a compile may take before it counts as failed.
 _COMPILE_TIMEOUT = 600
 
@@ -74,18 +80,27 @@ _transposes: weakref.WeakKeyDictionary[AttentionGraph, tuple[torch.Tensor, torch
     weakref.WeakKeyDictionary()
 
 
-def attention_path() -> str:
+def attention_path(grad: bool = False) -> str:
     """``"fused"`` when GAT layers use the fused operator, else ``"pytorch"``
-    (:func:`fallback_reason` says why). Builds or loads the operator on first call."""
-    return "fused" if _requested() != "pytorch" and _load() else "pytorch"
+    (:func:`fallback_reason` says why), for inference (``grad=False``) or for a forward
+    that autograd records (``grad=True``: training). Builds or loads the operator on
+    first call."""
+    return "pytorch" if fallback_reason(grad) else "fused"
 
 
-def fallback_reason() -> str | None:
-    """Why the PyTorch path is used (``None`` when the fused one is)."""
-    if _requested() == "pytorch":
+def fallback_reason(grad: bool = False) -> str | None:
+    """Why the PyTorch path is used (``None`` when the fused one is); ``grad`` as in
+    :func:`attention_path`."""
+    requested = _requested()
+    if requested == "pytorch":
         source = "use_attention_path('pytorch')" if _override else f"{PATH_VARIABLE}=pytorch"
         return f"forced by {source}"
-    return None if _load() else _state.get("reason")
+    if not _load():
+        return _state.get("reason")
+    if requested == "auto" and grad and AUTO_UNDER_AUTOGRAD == "pytorch":
+        return (f"the default under autograd (measured slower than the PyTorch path; "
+                f"{PATH_VARIABLE}=fused uses it)")
+    return None
 
 
 @contextmanager
@@ -105,11 +120,12 @@ def use_attention_path(path: str | None) -> Iterator[None]:
         _override.pop()
 
 
-def fused_applicable(h: torch.Tensor, training_dropout: bool) -> bool:
+def fused_applicable(h: torch.Tensor, training_dropout: bool, grad: bool) -> bool:
     """Whether a layer with projected features ``h`` runs on the fused operator: CPU,
-    float32/float64, no attention dropout (the operator has none), path available."""
+    float32/float64, no attention dropout (the operator has none), and the path chosen
+    (:func:`attention_path`) for a forward with (``grad``) or without autograd."""
     return (not training_dropout and h.device.type == "cpu"
-            and h.dtype in (torch.float32, torch.float64) and attention_path() == "fused")
+            and h.dtype in (torch.float32, torch.float64) and attention_path(grad) == "fused")
 
 
 def fused_graph_attention(h: torch.Tensor, a_src: torch.Tensor, a_dst: torch.Tensor,
@@ -205,10 +221,11 @@ class _FusedGraphAttention(torch.autograd.Function):
 
 
 def _requested() -> str:
+    """``pytorch``, ``fused`` or ``auto`` (also for an unknown value of the variable)."""
     if _override:
         return _override[-1]
     value = os.environ.get(PATH_VARIABLE, "auto").strip().lower()
-    return "pytorch" if value == "pytorch" else "fused"
+    return value if value in PATHS else "auto"
 
 
 def _load() -> bool:

@@ -95,7 +95,9 @@ class GraphAttention(nn.Module):
                 scores = self._scores(x.float(), h, weight.float())
         else:
             scores = self._scores(x, h, weight)
-        if fused_applicable(h, self.dropout > 0 and self.training):
+        grad = torch.is_grad_enabled() and (scores.requires_grad or h.requires_grad
+                                            or self.bias.requires_grad)
+        if fused_applicable(h, self.dropout > 0 and self.training, grad):
             # One pass per CSR row in C++ (gnngarment.model.fused_attention); below is
             # the PyTorch path, the fallback and the reference.
             return fused_graph_attention(h, scores[:, :heads], scores[:, heads:2 * heads],
