@@ -177,3 +177,29 @@ def test_bad_inputs_are_rejected() -> None:
     with pytest.raises(RuntimeError, match="rows"):
         torch.ops.gnngarment.graph_attention_forward(
             graph.ptr, graph.source, 1, h, scores, scores, torch.zeros(2), 0.2, False)
+
+
+def test_a_machine_without_a_compiler_runs_the_pytorch_path(tmp_path) -> None:
+    """No compiler and no cached library: the fallback, with the reason, and the layer
+    still runs (a fresh process: the operator is loaded once per process)."""
+    import os
+    import subprocess
+    import sys
+
+    code = (
+        "import torch\n"
+        "from gnngarment.model import fused_attention as f\n"
+        "from gnngarment.model.attention_graph import AttentionGraph\n"
+        "from gnngarment.model.graph_attention import GraphAttention\n"
+        "print(f.attention_path(), '|', f.fallback_reason())\n"
+        "graph = AttentionGraph.from_edge_index(torch.tensor([[0, 1], [1, 2]]), 3)\n"
+        "print(tuple(GraphAttention(4, 2, heads=2)(torch.randn(3, 4), graph).shape))\n")
+    env = {key: value for key, value in os.environ.items() if key != "CXX"}
+    env.update(PATH=str(tmp_path), GNNGARMENT_EXTENSION_DIR=str(tmp_path / "cache"),
+               GNNGARMENT_ATTENTION="auto")
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                          text=True, timeout=120, check=False)
+    assert done.returncode == 0, done.stderr
+    first, shape = done.stdout.strip().splitlines()
+    assert first.startswith("pytorch | RuntimeError: no C++ compiler found")
+    assert shape == "(3, 4)"
