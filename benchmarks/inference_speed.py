@@ -7,7 +7,13 @@ per-frame model (both LSTMs, M^mp, skinning) at each batch size under
 model (the shipped supervised-stage checkpoint uses only the supervised M^mp), with
 ``--physics on`` with both M^mp submodules (a model trained through the physics stage);
 both by default, each with its own ratio line — for both GAT
-implementations (``csr``: GraphAttention, ``pyg``: GATConv), with:
+implementations (``csr``: GraphAttention on its PyTorch path, ``fused``: GraphAttention on the
+fused C++ operator of :mod:`gnngarment.model.fused_attention`, ``pyg``: GATConv), with:
+
+* ``--attention fused csr``: the fused operator and its PyTorch fallback side by side in one
+  child (same weights, interleaved), with the fused ÷ fallback frames/s ratio per batch and
+  each one's ratio to the simulator (the child says which path ``fused`` really ran:
+  ``pytorch`` with the reason when the operator could not be built);
 
 * the peak resident memory of the measuring process (each config × implementation runs
   in its own child process, so its peak is its own);
@@ -79,6 +85,11 @@ from gnngarment.data.vertex_features import garment_vertex_features  # noqa: E40
 from gnngarment.geometry import GarmentPreparationConfig, prepare_garment  # noqa: E402
 from gnngarment.model import GarmentDeformer, ModelConfig, stack_hierarchies  # noqa: E402
 from gnngarment.model import deformer as deformer_module  # noqa: E402
+from gnngarment.model.fused_attention import (  # noqa: E402
+    attention_path,
+    fallback_reason,
+    use_attention_path,
+)
 from gnngarment.model.graph_attention import set_attention  # noqa: E402
 
 #: glibc settings that keep freed large blocks in the heap: by default every tensor
@@ -449,6 +460,23 @@ def start_competitor() -> subprocess.Popen:
                                                                      OMP_NUM_THREADS="1"))
 
 
+#: The fused-operator path each ``--attention`` value runs on (``None``: not a
+#: GraphAttention choice).
+ATTENTION_PATHS = {"csr": "pytorch", "fused": "fused", "pyg": None}
+
+
+def attention_module(impl: str) -> str:
+    """The layer implementation behind an ``--attention`` value (``fused`` is csr's
+    GraphAttention on the fused operator)."""
+    return "csr" if impl == "fused" else impl
+
+
+def run_on_path(model: GarmentDeformer, context, inputs: tuple, impl: str) -> torch.Tensor:
+    """Posed vertices of one batch, with GraphAttention on ``impl``'s path."""
+    with use_attention_path(ATTENTION_PATHS[impl]):
+        return model(context, *inputs).posed
+
+
 def child(args: argparse.Namespace) -> None:
     """Measure one config at one thread count, every implementation in ``--impl``
     interleaved; print one JSON line per implementation."""
@@ -474,11 +502,16 @@ def child(args: argparse.Namespace) -> None:
     models, contexts, results = {}, {}, {}
     with torch.inference_mode():
         for impl in args.impl:
-            models[impl] = set_attention(copy.deepcopy(base), impl)  # same weights
+            models[impl] = set_attention(copy.deepcopy(base), attention_module(impl))
             timer.attach(models[impl])
             tic = time.perf_counter()
-            contexts[impl] = models[impl].encode([pair])
+            with use_attention_path(ATTENTION_PATHS[impl]):
+                contexts[impl] = models[impl].encode([pair])
+                path = attention_path()
+                reason = fallback_reason()
             results[impl] = {"config": args.config, "attention": impl, "vertices": len(pos),
+                             "path": path if ATTENTION_PATHS[impl] else "pyg",
+                             "path_reason": reason,
                              "physics": physics,
                              "threads": threads, "weights": weights,
                              "prepare_s": time.perf_counter() - tic,
@@ -497,7 +530,8 @@ def child(args: argparse.Namespace) -> None:
         for frames in args.batches:
             inputs = frame_inputs(config, frames)
             runs: dict[str, Callable[[], torch.Tensor]] = {
-                impl: (lambda m=models[impl], c=contexts[impl], i=inputs: m(c, *i).posed)
+                impl: (lambda m=models[impl], c=contexts[impl], i=inputs, a=impl:
+                       run_on_path(m, c, i, a))
                 for impl in args.impl}
             first_calls: dict[str, dict] = {}
             if compiled:
@@ -634,6 +668,8 @@ def report(results: list[dict]) -> dict[str, float]:
             fps = int(frames) / e["best_s"]
             if int(frames) == largest:
                 best[variant(r)] = max(best.get(variant(r), 0.0), fps)
+                key = f"{variant(r)}, {r['attention']}"
+                best[key] = max(best.get(key, 0.0), fps)
             print(f"| {label(r)} | {frames} | {1000 * e['best_s']:.0f} | {fps:.1f} "
                   f"| {int(frames) / e['median_s']:.1f} | {e['peak_rss_mb']:.0f} |")
     for r in results:
@@ -642,6 +678,24 @@ def report(results: list[dict]) -> dict[str, float]:
                 if key.startswith("max_diff_vs_"):
                     print(f"max |posed({r['attention']}) − posed({key[12:]})|, {label(r)}, "
                           f"batch {frames}: {diff:.2e} m")
+
+    pairs = [(r, q) for r in results for q in results
+             if r["attention"] == "fused" and q["attention"] == "csr"
+             and label(r).split("|", 2)[2] == label(q).split("|", 2)[2]
+             and variant(r) == variant(q)]
+    if pairs:
+        print("\n## fused operator vs its PyTorch fallback (same child, interleaved)")
+        print("| config | malloc | threads | batch | path | fallback frames/s "
+              "| fused frames/s | fused ÷ fallback (best) | (median) |")
+        print("|---|---|---|---|---|---|---|---|---|")
+        for r, q in pairs:
+            for frames, e in r["batches"].items():
+                o = q["batches"][frames]
+                path = r["path"] + (f" ({r['path_reason']})" if r.get("path_reason") else "")
+                print(f"| {variant(r)} | {r.get('malloc', 'default')} | {r['threads']} "
+                      f"| {frames} | {path} | {int(frames) / o['best_s']:.1f} "
+                      f"| {int(frames) / e['best_s']:.1f} | {o['best_s'] / e['best_s']:.2f}× "
+                      f"| {o['median_s'] / e['median_s']:.2f}× |")
 
     print("\n## where the time goes (best run, ms per batch)")
     print("| config | attention | malloc | threads | batch | E^t1 LSTM | E^t2 LSTM "
@@ -727,7 +781,9 @@ def main() -> None:
     parser.add_argument("--configs", nargs="+", default=["small", "paper"])
     parser.add_argument("--batches", type=int, nargs="+", default=[1, 16])
     parser.add_argument("--attention", nargs="+", default=["csr", "pyg"],
-                        choices=["csr", "pyg"])
+                        choices=["csr", "fused", "pyg"],
+                        help="csr: GraphAttention's PyTorch path (the fallback); fused: "
+                             "GraphAttention on the fused C++ operator; pyg: GATConv")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--threads", nargs="+", default=["1", "2", "auto"],
                         choices=["1", "2", "3", "4", "8", "16", "auto"],

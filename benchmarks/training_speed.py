@@ -10,7 +10,12 @@ mixed garments).
 
     .venv/bin/python benchmarks/training_speed.py [--config configs/train/demo.yaml]
         [--data data/demo] [--steps 10] [--threads 1] [--deterministic on|off|both]
-        [--processes 1] [--set pairs_per_batch=1 ...]
+        [--processes 1] [--set pairs_per_batch=1 ...] [--attention-path fused pytorch]
+
+``--attention-path fused pytorch`` measures the same run with the GAT layers on the fused
+C++ operator (:mod:`gnngarment.model.fused_attention`) and on its PyTorch fallback, one
+after the other in this process, and prints the ratio per stage (``auto``, the default:
+whatever the library chooses, one run).
 
 ``--processes P`` measures data-parallel training as ``torchrun --nproc_per_node P``
 runs it: P processes (gloo, ``--threads`` threads each), each stepping on its own batch
@@ -46,6 +51,11 @@ if str(ROOT) not in sys.path:
 
 from gnngarment.allocator import keep_freed_memory  # noqa: E402
 from gnngarment.data import PreparedDataset  # noqa: E402
+from gnngarment.model.fused_attention import (  # noqa: E402
+    attention_path,
+    fallback_reason,
+    use_attention_path,
+)
 from gnngarment.training.loading import load_training_config  # noqa: E402
 from gnngarment.training.trainer import Trainer, set_stage  # noqa: E402
 
@@ -139,6 +149,10 @@ def main() -> None:
                         help="data-parallel processes (gloo + DDP, as torchrun runs them)")
     parser.add_argument("--set", action="append", default=[],
                         help="override a training setting, e.g. --set pairs_per_batch=1")
+    parser.add_argument("--attention-path", nargs="+", choices=("auto", "fused", "pytorch"),
+                        default=["auto"],
+                        help="GAT path(s) to measure, each a run of its own (auto: the "
+                             "library's choice)")
     parser.add_argument("--json", type=Path, help="also write the results here")
     args = parser.parse_args()
     if args.processes < 1:
@@ -155,26 +169,48 @@ def main() -> None:
           f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores, freed memory "
           f"{'kept for reuse' if kept else 'unmapped (glibc default)'}")
     modes = {"on": [True], "off": [False], "both": [False, True]}[args.deterministic]
-    runs = [measure(args.config, args.data, args.steps, args.threads, mode, args.set)
-            if args.processes == 1 else measure_in_processes(args, mode) for mode in modes]
+    runs = []
+    for path in dict.fromkeys(args.attention_path):
+        with use_attention_path(None if path == "auto" else path):
+            training_path = attention_path(grad=True)
+            reason = fallback_reason(grad=True)
+            for mode in modes:
+                results = (measure(args.config, args.data, args.steps, args.threads, mode,
+                                   args.set)
+                           if args.processes == 1 else measure_in_processes(args, mode))
+                results["attention_path"] = path
+                results["path"] = training_path + (f" ({reason})" if reason else "")
+                runs.append(results)
     for results in runs:
         print(f"{results['pairs_per_batch']} pairs × {results['frames_per_pair']} frames per "
               f"batch and process, {results['processes']} process(es), {args.steps} steps "
               f"per stage after one warm-up step, {args.data}, "
-              f"deterministic {'on' if results['deterministic'] else 'off'}")
+              f"deterministic {'on' if results['deterministic'] else 'off'}, GAT path "
+              f"{results['attention_path']} = {results['path']}")
         print("| stage | s/step (mean) | s/step (median) | frames/s | vertices/s |")
         print("|---|---|---|---|---|")
         for stage, row in results["stages"].items():
             print(f"| {stage} | {row['seconds_per_step']:.3f} | "
                   f"{row['median_seconds_per_step']:.3f} | {row['frames_per_second']:.1f} | "
                   f"{row['vertices_per_second']:.0f} |")
-    if len(runs) == 2:
-        median = "median_seconds_per_step"
-        ratios = ", ".join(f"{stage} {runs[1]['stages'][stage][median] / row[median]:.2f}x"
-                           for stage, row in runs[0]["stages"].items())
-        print(f"deterministic on / off, median s/step: {ratios}")
+    median = "median_seconds_per_step"
+    if len(modes) == 2:
+        for before, after in zip(runs[::2], runs[1::2], strict=True):
+            ratios = ", ".join(f"{stage} {after['stages'][stage][median] / row[median]:.2f}x"
+                               for stage, row in before["stages"].items())
+            print(f"deterministic on / off, median s/step ({before['attention_path']}): "
+                  f"{ratios}")
+    by_path = {(r["attention_path"], r["deterministic"]): r for r in runs}
+    for mode in modes:
+        fused, fallback = by_path.get(("fused", mode)), by_path.get(("pytorch", mode))
+        if fused and fallback:
+            ratios = ", ".join(
+                f"{stage} {fallback['stages'][stage][median] / row[median]:.2f}x"
+                for stage, row in fused["stages"].items())
+            print(f"fused ÷ pytorch steps/s (median s/step ratio), deterministic "
+                  f"{'on' if mode else 'off'}: {ratios}")
     if args.json:
-        args.json.write_text(json.dumps(runs if len(runs) == 2 else runs[0], indent=2))
+        args.json.write_text(json.dumps(runs if len(runs) > 1 else runs[0], indent=2))
 
 
 if __name__ == "__main__":

@@ -60,6 +60,15 @@ def _garment_config(config_path: Path | None, levels: int | None):
     return config
 
 
+def _attention_paths() -> dict[str, str | None]:
+    """Which graph-attention path this machine runs (gnngarment.model.fused_attention):
+    for inference (animate) and for training, with the reason for a fallback."""
+    from gnngarment.model.fused_attention import attention_path, fallback_reason
+
+    return {"inference": attention_path(), "training": attention_path(grad=True),
+            "fallback_reason": fallback_reason() or fallback_reason(grad=True)}
+
+
 @app.command()
 def inspect(
     garment_mesh: Annotated[Path, typer.Argument(help="OBJ, PLY, OFF, STL, glTF or GLB file.")],
@@ -96,6 +105,7 @@ def inspect(
     hierarchy = prepared.hierarchy
     # Each component's centre at every level, in that level's numbering.
     centres = [level.centres.tolist() for level in hierarchy.levels]
+    attention = _attention_paths()
 
     if as_json:
         result = {
@@ -114,6 +124,7 @@ def inspect(
             "seconds": seconds,
             **({"rest_check": rest_state} if rest_state is not None else {}),
             **({"fit": fit} if fit is not None else {}),
+            "attention": attention,
         }
         print(json.dumps(result, indent=2))
         return
@@ -133,6 +144,9 @@ def inspect(
         text = ", ".join(map(str, shown[:8])) + (" ..." if len(shown) > 8 else "")
         table.add_row(str(k), str(n), str(e), text or "-")
     console.print(table)
+    reason = attention["fallback_reason"]
+    console.print(f"  graph attention: {attention['inference']} (inference), "
+                  f"{attention['training']} (training)" + (f"; {reason}" if reason else ""))
     counts = hierarchy.vertex_counts()
     stuck = next((k for k in range(1, len(counts)) if counts[k] == counts[k - 1]), None)
     if stuck is not None:

@@ -31,6 +31,7 @@ from torch_geometric.nn.inits import glorot, zeros
 from gnngarment.model.attention_graph import AttentionGraph
 from gnngarment.model.config import ATTENTION_IMPLEMENTATIONS
 from gnngarment.model.edge_softmax import edge_softmax
+from gnngarment.model.fused_attention import fused_applicable, fused_graph_attention
 from gnngarment.model.sparse_matrix import CsrMatmul
 
 
@@ -94,6 +95,13 @@ class GraphAttention(nn.Module):
                 scores = self._scores(x.float(), h, weight.float())
         else:
             scores = self._scores(x, h, weight)
+        grad = torch.is_grad_enabled() and (scores.requires_grad or h.requires_grad
+                                            or self.bias.requires_grad)
+        if fused_applicable(h, self.dropout > 0 and self.training, grad):
+            # One pass per CSR row in C++ (gnngarment.model.fused_attention); below is
+            # the PyTorch path, the fallback and the reference.
+            return fused_graph_attention(h, scores[:, :heads], scores[:, heads:2 * heads],
+                                         self.bias, graph, self.negative_slope, self.concat)
         layout = graph.layout(heads)
         alpha = edge_softmax(scores, heads, layout, self.negative_slope,
                              graph.block_layouts(heads))

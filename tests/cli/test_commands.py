@@ -48,6 +48,22 @@ def test_inspect_json_has_levels_kept_indices_and_descriptor(two_piece) -> None:
     assert set(report["seconds"]) >= {"load", "hierarchy", "descriptor"}
 
 
+def test_inspect_says_which_attention_path_runs(two_piece, monkeypatch) -> None:
+    """The fused operator or the PyTorch fallback, for inference and training, and why a
+    fallback is used (issue 39: the user can tell which path ran)."""
+    monkeypatch.setenv("GNNGARMENT_ATTENTION", "pytorch")
+    result = runner.invoke(app, ["inspect", str(two_piece["obj"]), "--json"])
+    assert result.exit_code == 0, result.output
+    attention = json.loads(result.output)["attention"]
+    assert attention == {"inference": "pytorch", "training": "pytorch",
+                         "fallback_reason": "forced by GNNGARMENT_ATTENTION=pytorch"}
+    monkeypatch.delenv("GNNGARMENT_ATTENTION")
+    attention = json.loads(runner.invoke(app, ["inspect", str(two_piece["obj"]),
+                                               "--json"]).output)["attention"]
+    assert attention["inference"] in ("fused", "pytorch")
+    assert (attention["fallback_reason"] is None) == (attention["inference"] == "fused")
+
+
 def test_bad_input_exits_2_with_a_message_and_no_traceback(tmp_path: Path) -> None:
     broken = tmp_path / "broken.obj"
     broken.write_text("v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n")
