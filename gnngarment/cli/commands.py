@@ -29,8 +29,31 @@ app = typer.Typer(help="Animate any garment mesh with one learned model.",
 console = Console()
 
 
+def _print_version(value: bool) -> None:
+    """``--version``: the package version and the shipped checkpoint's id (the first 12
+    hex digits of its content hash), then exit."""
+    if not value:
+        return
+    from gnngarment import __version__
+    from gnngarment.paths import SHIPPED_MODEL
+
+    try:
+        from gnngarment.model.checkpoint import CONTENT_HASH_KEY, load_checkpoint
+
+        model = load_checkpoint(SHIPPED_MODEL).get(CONTENT_HASH_KEY, "")[:12]
+    except ValueError as error:
+        model = f"unreadable: {error}"
+    console.print(f"gnngarment {__version__}; shipped model {SHIPPED_MODEL.name} {model}",
+                  highlight=False)
+    raise typer.Exit()
+
+
 @app.callback()
-def root() -> None:
+def root(
+    version: Annotated[bool, typer.Option(
+        "--version", callback=_print_version, is_eager=True,
+        help="Print the version and the shipped model's id, then exit.")] = False,
+) -> None:
     """Animate any garment mesh with one learned model."""
     # Every command: freed tensors are reused instead of unmapped (gnngarment/allocator.py).
     keep_freed_memory()
