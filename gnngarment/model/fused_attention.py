@@ -66,8 +66,9 @@ PATHS = ("fused", "pytorch")
 #: does not know ``-march=native``.
 _ARCH_FLAGS = (["-march=native"], [])
 #: What ``auto`` uses where autograd records the forward (training): on the shipped
-#: training recipe the fused path measured 1.12-1.31x (supervised) and 0.98-1.10x
-#: (physics stages) the PyTorch path's steps/s (docs/performance.md, "Fused attention").
+#: training recipe the fused path measured 1.09x (supervised), 1.14x (physics) and 1.17x
+#: (physics + strain) the PyTorch path's frames/s, mean of six rounds on 2 AMD EPYC cores
+#: (docs/performance.md, "Fused graph-attention operator").
 AUTO_UNDER_AUTOGRAD = "fused"
 #: Seconds a compile may take before it counts as failed.
 _COMPILE_TIMEOUT = 600
