@@ -615,7 +615,9 @@ def _drape(placed, faces, body_inputs, garment_mesh: Path):
 @app.command()
 def animate(
     context: typer.Context,
-    garment_mesh: Annotated[Path, typer.Argument(help="Garment in the rest body's frame.")],
+    garment_meshes: Annotated[list[Path], typer.Argument(
+        help="Garment mesh in the rest body's frame; several garments are animated as one "
+             "outfit (docs/your_own_garment.md, \"Outfits\").")],
     out: Annotated[Path, typer.Option(help="Output folder.")] = Path("animated"),
     checkpoint: Annotated[Path | None, typer.Option(
         help="Model checkpoint (default: the shipped models/gnngarment-small.pt).")] = None,
@@ -655,8 +657,23 @@ def animate(
              "configs/collisions.yaml), the rest garment and every frame.")] = True,
     lead_in: Annotated[float | None, typer.Option(help=LEAD_IN_HELP)] = None,
     allow_unverified: Annotated[bool, typer.Option(help=ALLOW_UNVERIFIED_HELP)] = False,
+    layers: Annotated[str | None, typer.Option(
+        help="Outfits: the garments' names (file stems), innermost first, comma-separated "
+             "(default: inferred at rest from which lies outside where they overlap).")
+                      ] = None,
+    split_parts: Annotated[bool, typer.Option(
+        help="Outfits: animate each connected part of a file as its own garment "
+             "(<stem>_1, <stem>_2, ...; a top and a bottom saved in one file).")] = False,
 ) -> None:
-    """Animate a garment mesh on a body and motion; write OBJ/PC2/glb/GIF."""
+    """Animate a garment mesh (or an outfit of several) on a body and motion; write
+    OBJ/PC2/glb/GIF."""
+    if len(garment_meshes) > 1 or split_parts or layers is not None:
+        return _animate_outfit(
+            context, garment_meshes, out, checkpoint, body_shape, motion, duration, fps,
+            joint_map, motion_up_axis, formats, body, fix_units, up_axis, scale, offset,
+            source_body, drape, ignore_placement, influences, resolve_collisions, lead_in,
+            allow_unverified, layers, split_parts)
+    garment_mesh = garment_meshes[0]
     from tqdm import tqdm
 
     from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs
@@ -782,3 +799,165 @@ def main() -> None:
     """Console-script entry point."""
     app()
 
+
+
+#: Stem of an outfit's glb, preview and manifest.
+OUTFIT_NAME = "outfit"
+
+
+def _outfit_garments(paths: list[Path], split_parts: bool):
+    """``(name, pos, faces, file)`` per garment of the files (each connected part its own
+    with ``split_parts``), or a clear failure."""
+    from gnngarment.geometry.errors import MeshError
+    from gnngarment.geometry.garment_layers import connected_parts, part_mesh
+    from gnngarment.geometry.mesh_io import load_mesh
+    from gnngarment.geometry.validation import validate_mesh
+
+    garments = []
+    for path in paths:
+        try:
+            pos, faces = load_mesh(path)
+            validate_mesh(pos, faces, str(path))
+        except (MeshError, ValueError) as error:
+            raise fail(str(error)) from None
+        stem = _export_name(path)
+        parts = connected_parts(faces, len(pos)) if split_parts else [None]
+        if split_parts and len(parts) == 1:
+            console.print(f"[yellow]outfit:[/] {path} has one connected part")
+        for number, part in enumerate(parts, start=1):
+            part_pos, part_faces = (pos, faces) if len(parts) == 1 else part_mesh(pos, faces,
+                                                                                 part)
+            name = stem if len(parts) == 1 else f"{stem}_{number}"
+            garments.append((name, part_pos, part_faces, path))
+    names = [name for name, *_ in garments]
+    for name in names:
+        if names.count(name) > 1 or name == OUTFIT_NAME:
+            raise fail(f"{name}: two garments of the outfit (or the outfit itself) would "
+                       "share this name: rename a file")
+    return garments
+
+
+def _animate_outfit(context, paths, out, checkpoint, body_shape, motion, duration, fps,
+                    joint_map, motion_up_axis, formats, body, fix_units, up_axis, scale,
+                    offset, source_body, drape, ignore_placement, influences,
+                    resolve_collisions, lead_in, allow_unverified, layers, split_parts
+                    ) -> None:
+    """``animate`` of several garments (or the parts of one file) as one outfit."""
+    from tqdm import tqdm
+
+    from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs
+    from gnngarment.geometry.errors import MeshError
+    from gnngarment.geometry.garment_layers import LayerOrderError
+    from gnngarment.geometry.mesh_io import load_mesh
+    from gnngarment.inference.animation_memory import animation_memory_problem
+    from gnngarment.inference.export.outfit_export import export_outfit, outfit_paths
+    from gnngarment.inference.outfit import OutfitGarment, animate_outfit
+    from gnngarment.inference.output_folder import check_outputs_spare_inputs
+    from gnngarment.inference.placement import place_garment
+    from gnngarment.model.checkpoint import load_model
+    from gnngarment.paths import SHIPPED_MODEL
+
+    format_list = [f.strip() for f in formats.split(",")]
+    _check_animate_options(fps, duration, motion_up_axis, format_list, fix_units, up_axis,
+                           scale, offset, influences)
+    lead_in_seconds = _lead_in_seconds(motion, lead_in)
+    checkpoint = checkpoint or SHIPPED_MODEL
+    garments = _outfit_garments(list(paths), split_parts)
+    names = [name for name, *_ in garments]
+    layer_names = None if layers is None else [n.strip() for n in layers.split(",")]
+    if layer_names is not None and sorted(layer_names) != sorted(names):
+        raise fail(f"--layers {layers}: must name every garment of the outfit once "
+                   f"({', '.join(names)})")
+    inputs = [*paths, checkpoint, source_body, joint_map, Path(motion), Path(body_shape)]
+    for name in names:
+        _refuse_outputs_over_inputs(out, name, format_list, body, inputs)
+    try:
+        check_outputs_spare_inputs(outfit_paths(out, OUTFIT_NAME, format_list), [],
+                                   [p for p in inputs if p is not None])
+    except ValueError as error:
+        raise fail(str(error)) from None
+    use_idle_cores()
+    try:
+        model = load_model(checkpoint, allow_unverified)
+        source = None if source_body is None else load_mesh(source_body)
+    except (MeshError, ValueError) as error:
+        raise fail(str(error)) from None
+    body_model, shape, motion_value = _load_body_and_motion(body_shape, motion, fps, duration,
+                                                            joint_map, motion_up_axis,
+                                                            lead_in_seconds)
+    problem = animation_memory_problem(len(motion_value),
+                                       sum(len(pos) for _, pos, _, _ in garments))
+    if problem:
+        raise fail(problem)
+    body_inputs = body_shape_inputs(body_model, shape, model.config.body_vertices)
+    placed = []
+    for name, pos, faces, path in garments:
+        try:
+            one = place_garment(pos, faces, body_inputs, units=fix_units, up_axis=up_axis,
+                                scale=scale, offset=None if offset is None else list(offset),
+                                source_body=source)
+        except ValueError as error:
+            raise fail(f"{source_body or path}: {error}") from None
+        for message in one.messages:
+            console.print(f"[yellow]placement ({name}):[/] {message}")
+        placed.append(one)
+    lock = _hold_output_folder(context, out) if drape else None
+    outfit = []
+    for (name, _, faces, path), one in zip(garments, placed, strict=True):
+        if drape:  # each garment alone; the layer resolution then separates them at rest
+            one = _drape(one, faces, body_inputs, path)
+        refuse_misplaced_garment(console, one.pos, faces, body_inputs, path, ignore_placement,
+                                 "--source-body, --fix-units/--scale, --up-axis, --offset, "
+                                 "or --ignore-placement")
+        outfit.append(OutfitGarment(name=name, pos=one.pos, faces=faces))
+    if lock is None:
+        lock = _hold_output_folder(context, out)
+    frames = body_motion_inputs(body_model, shape, motion_value, model.config.body_vertices)
+    bar = tqdm(total=len(motion_value) * len(outfit), desc="animating", unit="frame")
+    try:
+        result = animate_outfit(model, outfit, body_inputs, frames, layers=layer_names,
+                                progress=lambda done, total: bar.update(done - bar.n),
+                                resolve_collisions=resolve_collisions,
+                                collisions=_collision_settings() if resolve_collisions
+                                else None, layer_settings=_layer_settings())
+    except (LayerOrderError, MeshError) as error:
+        raise fail(str(error)) from None
+    bar.close()
+    console.print("layers (innermost first): "
+                  + ", ".join(result.names[index] for index in result.order))
+    for index, share in result.penetration.items():
+        stats = result.layer_stats.get(index)
+        push = ""
+        if stats is not None:
+            rest_push = result.rest_layer_stats[index].max_push.max()
+            push = (f", largest push {1000 * stats.max_push.max():.1f} mm per frame (rest "
+                    f"{1000 * rest_push:.1f} mm)")
+        raw = 100 * result.penetration_raw[index].mean()
+        console.print(f"{result.names[index]}: {raw:.2f} % of its vertices through the "
+                      f"garment beneath in the network's output, {100 * share.mean():.2f} % "
+                      f"after resolution{push}")
+    try:
+        written = export_outfit(result, out, OUTFIT_NAME, formats=format_list,
+                                include_body=body, max_influences=influences, lock=lock)
+    except (ValueError, OSError) as error:
+        raise fail(str(error)) from None
+    console.print(f"[green]animated[/] {len(result.names)} garments, {len(motion_value)} "
+                  f"frames (layers {result.seconds['layers']:.2f} s)"
+                  f"{_lead_in_note(lead_in_seconds, fps)}; wrote:")
+    for key, path in written.items():
+        console.print(f"  {key}: {path}")
+
+
+def _layer_settings():
+    """``configs/layers.yaml`` (or the dataclass defaults it mirrors), or a clear failure."""
+    from gnngarment.config import ConfigError, load_config
+    from gnngarment.geometry.garment_layers import LayerSettings
+    from gnngarment.paths import default_config
+
+    path = default_config("layers.yaml")
+    if not path.is_file():
+        return LayerSettings()
+    try:
+        return load_config(path, LayerSettings)
+    except (ConfigError, ValueError) as error:
+        raise fail(f"{path}: {error}") from None

@@ -82,6 +82,46 @@ class CollisionStats:
 _ACCEPT = 1e-3
 
 
+class PushGraph:
+    """A garment's edge graph as the collision resolutions spread pushes over it.
+
+    Attributes:
+        indptr, neighbours: CSR rows of the graph (both directions), ``(N + 1,)``, ``(E,)``.
+        smoothing: one Jacobi pass of the uniform Laplacian, ``x ← ½ (x + mean of the
+            neighbours)``, as a sparse ``(N, N)`` matrix (isolated vertices kept).
+    """
+
+    def __init__(self, faces: np.ndarray, num_vertices: int) -> None:
+        import scipy.sparse as sp
+
+        source, target = edge_index_from_faces(faces, num_vertices)
+        self.indptr = np.searchsorted(source, np.arange(num_vertices + 1))
+        self.neighbours = target
+        degree = np.diff(self.indptr)
+        weight = np.repeat(0.5 / np.maximum(degree, 1), degree)
+        self.smoothing = (sp.csr_matrix((weight, target, self.indptr),
+                                        shape=(num_vertices, num_vertices))
+                          + sp.diags(np.where(degree > 0, 0.5, 1.0))).tocsr()
+
+    def smoothed_shift(self, need: np.ndarray, normal: np.ndarray, pos: np.ndarray,
+                       radius: float, iterations: int) -> np.ndarray:
+        """The displacement ``(N, 3)`` [m] that gives every vertex at least its push
+        ``need (N,)`` [m] along its unit ``normal (N, 3)`` (0 where not pushed), spread
+        over the graph with a linear falloff over ``radius`` (:func:`spread_pushes`) and
+        ``iterations`` Jacobi passes, each topped up to the pushes again."""
+        shift = spread_pushes(need, normal, pos, self.indptr, self.neighbours, radius)
+        # A colliding vertex whose value came from a neighbour's tent moves along that
+        # neighbour's direction: top it up to its own push along its own. Then Jacobi
+        # passes blend the directions where they turn fast (deep in a thin limb,
+        # neighbours' closest points lie on opposite sides), topping up after each.
+        for step in range(iterations + 1):
+            if step:
+                shift = self.smoothing @ shift
+            along = np.einsum("na,na->n", shift, normal)
+            shift += np.maximum(need - along, 0.0)[:, None] * normal
+        return shift
+
+
 class BodyCollider:
     """A body mesh that moves frame by frame (refit, never rebuilt) and a garment's
     edge graph: the signed offsets of garment vertices from the body.
@@ -95,23 +135,14 @@ class BodyCollider:
 
     def __init__(self, body_vertices: np.ndarray, body_faces: np.ndarray, faces: np.ndarray,
                  num_vertices: int, band: float) -> None:
-        import scipy.sparse as sp
-
         from gnngarment.geometry.signed_distance import warp_mesh
 
         self.mesh = warp_mesh(body_vertices, body_faces)
         self.band = float(band)
         self.num_vertices = int(num_vertices)
-        # CSR rows of the garment graph (both directions), and each edge once.
+        self.graph = PushGraph(faces, num_vertices)
+        self.indptr, self.neighbours = self.graph.indptr, self.graph.neighbours
         source, target = edge_index_from_faces(faces, num_vertices)
-        self.indptr = np.searchsorted(source, np.arange(num_vertices + 1))
-        self.neighbours = target
-        # One Jacobi pass of the uniform Laplacian: x ← ½ (x + mean of the neighbours).
-        degree = np.diff(self.indptr)
-        weight = np.repeat(0.5 / np.maximum(degree, 1), degree)
-        self.smoothing = (sp.csr_matrix((weight, target, self.indptr),
-                                        shape=(num_vertices, num_vertices))
-                          + sp.diags(np.where(degree > 0, 0.5, 1.0))).tocsr()
         once = source < target
         self._first, self._second = source[once], target[once]
         self._once_indptr = np.searchsorted(self._first, np.arange(num_vertices + 1))
@@ -295,17 +326,8 @@ def resolve_collisions(garment: np.ndarray, faces: np.ndarray, body_vertices: np
             continue
         need = np.where(close, epsilon - distance, 0.0)        # (N,) push length [m]
         normal = np.where(close[:, None], direction, 0.0)      # (N, 3)
-        shift = spread_pushes(need, normal, pos[t], collider.indptr, collider.neighbours,
-                              settings.smoothing_radius)
-        # A colliding vertex whose value came from a neighbour's tent moves along that
-        # neighbour's direction: top it up to its own push along its own. Then Jacobi
-        # passes blend the directions where they turn fast (deep in a thin limb,
-        # neighbours' closest points lie on opposite sides), topping up after each.
-        for step in range(settings.smoothing_iterations + 1):
-            if step:
-                shift = collider.smoothing @ shift
-            along = np.einsum("na,na->n", shift, normal)
-            shift += np.maximum(need - along, 0.0)[:, None] * normal
+        shift = collider.graph.smoothed_shift(need, normal, pos[t], settings.smoothing_radius,
+                                              settings.smoothing_iterations)
         push = np.linalg.norm(shift, axis=1)
         was_far = ~np.isfinite(distance)
         # Check every moved vertex that may have come closer than ε (a vertex moved by

@@ -144,7 +144,32 @@ def _kernels() -> dict[str, Any]:
             origin = origin + ray * (hit.t + 1.0e-6)
         inside[tid] = wp.int8(crossings % 2)
 
-    return {"signed_distance": signed_distance, "offsets": offsets, "parity": parity}
+    @wp.kernel
+    def side_offsets(mesh: wp.uint64, points: wp.array(dtype=wp.vec3), max_dist: float,
+                     height: wp.array(dtype=float), normal: wp.array(dtype=wp.vec3),
+                     alignment: wp.array(dtype=float)):
+        # An open surface has no inside: the side is the closest face's normal's.
+        tid = wp.tid()
+        point = points[tid]
+        query = wp.mesh_query_point_no_sign(mesh, point, max_dist)
+        if query.result:
+            surface = wp.mesh_eval_position(mesh, query.face, query.u, query.v)
+            face_normal = wp.mesh_eval_face_normal(mesh, query.face)
+            offset = point - surface
+            along = wp.dot(offset, face_normal)
+            length = wp.length(offset)
+            height[tid] = along
+            normal[tid] = face_normal
+            alignment[tid] = 1.0
+            if length > 1.0e-7:
+                alignment[tid] = wp.abs(along) / length
+        else:
+            height[tid] = wp.inf
+            normal[tid] = wp.vec3(0.0, 0.0, 0.0)
+            alignment[tid] = 0.0
+
+    return {"signed_distance": signed_distance, "offsets": offsets, "parity": parity,
+            "side_offsets": side_offsets}
 
 
 def signed_distance_warp(mesh: Any, points: np.ndarray) -> np.ndarray:
@@ -231,3 +256,33 @@ def inside_by_parity(mesh: Any, points: np.ndarray) -> np.ndarray:
                   inputs=[mesh.id, wp.array(points, dtype=wp.vec3, device="cpu"), inside],
                   device="cpu")
     return inside.numpy().astype(bool)
+
+
+def side_offsets(mesh: Any, points: np.ndarray, max_dist: float
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where points lie relative to an open surface (a garment), by its closest face.
+
+    Args:
+        mesh: a ``warp.Mesh`` on the CPU; its winding says which side is "outside".
+        points: ``(N, 3)`` [m].
+        max_dist: closest points are searched this far [m].
+
+    Returns:
+        height ``(N,)`` [m]: the offset from the closest surface point along that face's
+        unit normal (negative: behind the surface; ``inf``: no surface within
+        ``max_dist``), the normal ``(N, 3)`` and the alignment ``(N,)`` in [0, 1]:
+        ``|height| / distance`` — near 1 where the point lies over the surface, near 0
+        beyond its boundary (a point past a hem, level with it), float32.
+    """
+    wp = import_warp()
+    points = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
+    count = len(points)
+    height = wp.empty(count, dtype=float, device="cpu")
+    normal = wp.empty(count, dtype=wp.vec3, device="cpu")
+    alignment = wp.empty(count, dtype=float, device="cpu")
+    if count:
+        wp.launch(_kernels()["side_offsets"], dim=count,
+                  inputs=[mesh.id, wp.array(points, dtype=wp.vec3, device="cpu"),
+                          float(max_dist), height, normal, alignment], device="cpu")
+    return (height.numpy().copy(), normal.numpy().reshape(count, 3).copy(),
+            alignment.numpy().copy())

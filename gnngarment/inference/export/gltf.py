@@ -29,6 +29,7 @@ What is written (see ``docs/export.md``):
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from numbers import Integral
 from pathlib import Path
@@ -142,9 +143,49 @@ def write_glb(animation: Animation, path: str | Path, *, name: str = "garment",
     Raises:
         ValueError: inconsistent animation arrays or bad options.
     """
+    return write_outfit_glb([(name, animation)], path, name=name,
+                            max_influences=max_influences, reference=reference,
+                            morph_interpolation=morph_interpolation,
+                            include_body=include_body, normals=normals, verify=verify,
+                            first_frame=first_frame)
+
+
+#: Garment colours of an outfit's glb, innermost first (the first is a single garment's).
+GARMENT_COLOURS = (GARMENT_COLOUR, (0.22, 0.38, 0.75, 1.0), (0.25, 0.60, 0.32, 1.0),
+                   (0.85, 0.70, 0.20, 1.0))
+
+
+def write_outfit_glb(parts: Sequence[tuple[str, Animation]], path: str | Path, *,
+                     name: str = "outfit", max_influences: int = 4,
+                     reference: str | int = "mean", morph_interpolation: str = "LINEAR",
+                     include_body: bool = False, normals: bool = True, verify: bool = True,
+                     first_frame: int = 0) -> GlbExport:
+    """Write several garments animated on one body as one glb: one skinned, morph-animated
+    mesh per garment (named ``parts[k][0]``) on one skeleton, one animation.
+
+    Every part must share the skeleton's motion (``joint_transforms``, ``rest_joints``,
+    ``fps``, frame count); the body comes from the first. Options as :func:`write_glb`;
+    the errors in the returned :class:`GlbExport` are over all garments (largest, mean),
+    ``seam_vertices`` and ``ill_conditioned`` summed.
+
+    Raises:
+        ValueError: no part, parts that do not share the motion, or bad options.
+    """
     import pygltflib
 
-    check_animation(animation)
+    if not parts:
+        raise ValueError("write_outfit_glb needs at least one garment")
+    for _, animation in parts:
+        check_animation(animation)
+    first = parts[0][1]
+    for part_name, animation in parts[1:]:
+        if (len(animation.posed) != len(first.posed) or animation.fps != first.fps
+                or not np.array_equal(animation.joint_transforms, first.joint_transforms)
+                or not np.array_equal(animation.rest_joints, first.rest_joints)):
+            raise ValueError(f"{part_name}: its motion differs from {parts[0][0]}'s (an "
+                             "outfit's garments share one skeleton and its frames)")
+    if len({part_name for part_name, _ in parts}) != len(parts):
+        raise ValueError("the garments of an outfit glb need different names")
     if morph_interpolation not in INTERPOLATIONS:
         raise ValueError(f"morph_interpolation must be one of {INTERPOLATIONS}, "
                          f"got {morph_interpolation!r}")
@@ -154,59 +195,67 @@ def write_glb(animation: Animation, path: str | Path, *, name: str = "garment",
         raise ValueError(f"first_frame must be an integer ≥ 0 (glTF times are ≥ 0), "
                          f"got {first_frame!r}")
     path = Path(path)
-    frames = len(animation.posed)
+    frames = len(first.posed)
     convert = GLTF_FROM_WORLD
     convert4 = np.eye(4)
     convert4[:3, :3] = convert
-    rest = np.asarray(animation.rest_pos, dtype=np.float64) @ convert.T
-    posed = np.asarray(animation.posed, dtype=np.float64) @ convert.T
-    transforms = convert4 @ np.asarray(animation.joint_transforms, dtype=np.float64) @ convert4.T
-    rest_joints = np.asarray(animation.rest_joints, dtype=np.float64) @ convert.T
+    transforms = convert4 @ np.asarray(first.joint_transforms, dtype=np.float64) @ convert4.T
+    rest_joints = np.asarray(first.rest_joints, dtype=np.float64) @ convert.T
 
     # Tracks as the file stores them (float32), and the transforms a viewer rebuilds.
     tracks = _float32_tracks(skeleton_animation(transforms, rest_joints))
     viewer_transforms = tracks.skinning_transforms()
-    skin = static_skin(animation.weights, max_influences, reference)
-    rest32 = rest.astype(np.float32).astype(np.float64)
-    residuals = rest_frame_residuals(rest32, posed, skin, viewer_transforms)
-    skin_only = np.linalg.norm(skin_static(rest32, None, skin, viewer_transforms) - posed,
-                               axis=-1)
-
     builder = _Builder()
-    faces = np.asarray(animation.faces, dtype=np.int64)
-    split = None
-    if animation.uv is not None:
-        split = split_uv_seams(faces, animation.uv, animation.uv_faces, len(rest32))
-    garment_primitive = _garment_primitive(builder, rest32, faces, residuals.offsets, skin,
-                                           normals, split)
     nodes, joint_nodes = _skeleton_nodes(tracks)
-    garment_node = len(nodes)
     targets = [f"frame_{t:04d}" for t in range(frames)]
-    extras: dict = {"targetNames": targets}
-    if split is not None and split.seam_vertices:
-        extras["seamSources"] = split.source[len(rest32):].tolist()
-    meshes = [pygltflib.Mesh(name=name, primitives=[garment_primitive],
-                             weights=_one_hot(frames, 0).tolist(), extras=extras)]
-    nodes.append(pygltflib.Node(name=name, mesh=0, skin=0))
-    materials = [_material(f"{name}_material", GARMENT_COLOUR, double_sided=True)]
-    scene_nodes = [0, garment_node]
-    body_node = None
+    meshes, materials, scene_nodes = [], [], [0]
+    garment_nodes: list[tuple[int, np.ndarray]] = []   # node, expected (T, N', 3)
+    skin_only, residual_max, ill_conditioned, seams = [], 0.0, 0, 0
+    for k, (part_name, animation) in enumerate(parts):
+        rest = np.asarray(animation.rest_pos, dtype=np.float64) @ convert.T
+        posed = np.asarray(animation.posed, dtype=np.float64) @ convert.T
+        skin = static_skin(animation.weights, max_influences, reference)
+        rest32 = rest.astype(np.float32).astype(np.float64)
+        residuals = rest_frame_residuals(rest32, posed, skin, viewer_transforms)
+        skin_only.append(np.linalg.norm(
+            skin_static(rest32, None, skin, viewer_transforms) - posed, axis=-1).ravel())
+        residual_max = max(residual_max,
+                           float(np.linalg.norm(residuals.offsets, axis=-1).max()))
+        ill_conditioned += residuals.ill_conditioned
+        faces = np.asarray(animation.faces, dtype=np.int64)
+        split = None
+        if animation.uv is not None:
+            split = split_uv_seams(faces, animation.uv, animation.uv_faces, len(rest32))
+            seams += split.seam_vertices
+        primitive = _garment_primitive(builder, rest32, faces, residuals.offsets, skin,
+                                       normals, split, material=len(materials))
+        extras: dict = {"targetNames": targets}
+        if split is not None and split.seam_vertices:
+            extras["seamSources"] = split.source[len(rest32):].tolist()
+        nodes.append(pygltflib.Node(name=part_name, mesh=len(meshes), skin=0))
+        meshes.append(pygltflib.Mesh(name=part_name, primitives=[primitive],
+                                     weights=_one_hot(frames, 0).tolist(), extras=extras))
+        materials.append(_material(f"{part_name}_material",
+                                   GARMENT_COLOURS[k % len(GARMENT_COLOURS)],
+                                   double_sided=True))
+        garment_nodes.append((len(nodes) - 1, posed if split is None else posed[:, split.source]))
+        scene_nodes.append(len(nodes) - 1)
+    morph_nodes = [(node, morph_interpolation) for node, _ in garment_nodes]
     if include_body:
-        body = np.asarray(animation.body_vertices, dtype=np.float64) @ convert.T
+        body = np.asarray(first.body_vertices, dtype=np.float64) @ convert.T
         body_primitive = _morph_only_primitive(builder, body,
-                                               np.asarray(animation.body_faces, np.int64))
+                                               np.asarray(first.body_faces, np.int64),
+                                               material=len(materials))
+        nodes.append(pygltflib.Node(name="body", mesh=len(meshes)))
         meshes.append(pygltflib.Mesh(name="body", primitives=[body_primitive],
                                      weights=_one_hot(frames, 0).tolist(),
                                      extras={"targetNames": targets}))
         materials.append(_material("body_material", BODY_COLOUR, double_sided=False))
-        body_node = len(nodes)
-        nodes.append(pygltflib.Node(name="body", mesh=1))
-        scene_nodes.append(body_node)
+        scene_nodes.append(len(nodes) - 1)
+        morph_nodes.append((len(nodes) - 1, morph_interpolation))
 
-    times = (first_frame + np.arange(frames, dtype=np.float64)) / float(animation.fps)
-    animation_record = _animation(builder, name, times, tracks, joint_nodes,
-                                  [(garment_node, morph_interpolation)] +
-                                  ([(body_node, morph_interpolation)] if include_body else []),
+    times = (first_frame + np.arange(frames, dtype=np.float64)) / float(first.fps)
+    animation_record = _animation(builder, name, times, tracks, joint_nodes, morph_nodes,
                                   frames)
     inverse_bind = builder.add(
         tracks.inverse_bind.transpose(0, 2, 1).reshape(-1, 16).astype(np.float32), "MAT4")
@@ -224,18 +273,18 @@ def write_glb(animation: Animation, path: str | Path, *, name: str = "garment",
 
     max_error = mean_error = None
     if verify:
-        decoded = evaluate_mesh_node(read_glb(path), garment_node,
-                                     builder.arrays["times"])
-        expected = posed if split is None else posed[:, split.source]
-        distance = np.linalg.norm(decoded - expected, axis=-1)
-        max_error, mean_error = float(distance.max()), float(distance.mean())
+        glb = read_glb(path)
+        distances = [np.linalg.norm(evaluate_mesh_node(glb, node, builder.arrays["times"])
+                                    - expected, axis=-1).ravel()
+                     for node, expected in garment_nodes]
+        every = np.concatenate(distances)
+        max_error, mean_error = float(every.max()), float(every.mean())
+    skin_errors = np.concatenate(skin_only)
     return GlbExport(
         path=path, num_frames=frames, max_influences=max_influences, max_error=max_error,
-        mean_error=mean_error, skin_only_max_error=float(skin_only.max()),
-        skin_only_mean_error=float(skin_only.mean()),
-        max_residual=float(np.linalg.norm(residuals.offsets, axis=-1).max()),
-        ill_conditioned=residuals.ill_conditioned, num_bytes=len(data),
-        seam_vertices=0 if split is None else split.seam_vertices,
+        mean_error=mean_error, skin_only_max_error=float(skin_errors.max()),
+        skin_only_mean_error=float(skin_errors.mean()), max_residual=residual_max,
+        ill_conditioned=ill_conditioned, num_bytes=len(data), seam_vertices=seams,
         start_time=float(builder.arrays["times"][0]))
 
 
@@ -282,7 +331,7 @@ def _unit_normals(pos: np.ndarray, faces: np.ndarray, fallback: np.ndarray | Non
 
 def _garment_primitive(builder: _Builder, rest: np.ndarray, faces: np.ndarray,
                        offsets: np.ndarray, skin: StaticSkin, normals: bool,
-                       split: SeamSplit | None = None):
+                       split: SeamSplit | None = None, material: int = 0):
     """The skinned, morph-targeted garment; with ``split``, over the seam-split vertices
     (normals are computed on the unsplit mesh, so seams stay smooth)."""
     import pygltflib
@@ -322,10 +371,11 @@ def _garment_primitive(builder: _Builder, rest: np.ndarray, faces: np.ndarray,
     split_faces = faces if split is None else split.faces
     return pygltflib.Primitive(attributes=attributes,
                                indices=_indices(builder, split_faces, count),
-                               targets=targets, material=0, mode=4)
+                               targets=targets, material=material, mode=4)
 
 
-def _morph_only_primitive(builder: _Builder, frames: np.ndarray, faces: np.ndarray):
+def _morph_only_primitive(builder: _Builder, frames: np.ndarray, faces: np.ndarray,
+                          material: int = 1):
     """Frame 0 as the base mesh, frame ``t − frame 0`` as target ``t`` (flat shaded)."""
     import pygltflib
 
@@ -336,7 +386,7 @@ def _morph_only_primitive(builder: _Builder, frames: np.ndarray, faces: np.ndarr
                                         bounds=True, target=ARRAY_BUFFER)} for frame in frames]
     return pygltflib.Primitive(attributes=attributes,
                                indices=_indices(builder, faces, len(base)), targets=targets,
-                               material=1, mode=4)
+                               material=material, mode=4)
 
 
 def _indices(builder: _Builder, faces: np.ndarray, count: int) -> int:
