@@ -3,9 +3,7 @@
 import numpy as np
 import pytest
 
-pytest.importorskip("warp")
-
-from gnngarment.geometry.garment_layers import (  # noqa: E402
+from gnngarment.geometry.garment_layers import (
     LayerOrderError,
     LayerSettings,
     connected_parts,

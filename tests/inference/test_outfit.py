@@ -6,15 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-pytest.importorskip("warp")
-
-from gnngarment.geometry.garment_layers import LayerSettings, outward_faces  # noqa: E402
-from gnngarment.inference.animate import animate  # noqa: E402
-from gnngarment.inference.outfit import OutfitGarment, animate_outfit  # noqa: E402
-from tests.inference.test_animate import scene  # noqa: E402,F401  (the fixture)
+from gnngarment.geometry.garment_layers import LayerSettings, outward_faces
+from gnngarment.inference.animate import animate
+from gnngarment.inference.outfit import OutfitGarment, animate_outfit
+from tests.inference.test_animate import scene  # noqa: F401 (the fixture)
 
 
-def garments(scene, outer_radius: float, outer_low: float):
+def garments(scene, outer_radius: float, outer_low: float):  # noqa: F811
     pos, faces = scene["pos"].copy(), scene["faces"]
     pos[:, :2] *= 0.16 / 0.13                        # inner: just outside the 0.14 body
     outer = pos.copy()
@@ -23,7 +21,7 @@ def garments(scene, outer_radius: float, outer_low: float):
     return [OutfitGarment("skirt", pos, faces), OutfitGarment("coat", outer, faces)]
 
 
-def test_garments_apart_come_out_exactly_as_alone(scene) -> None:
+def test_garments_apart_come_out_exactly_as_alone(scene) -> None:  # noqa: F811
     outfit = garments(scene, 0.2, 1.2)               # the "coat" hangs above the skirt
     result = animate_outfit(scene["model"], outfit, scene["body"], scene["frames"])
     assert result.relations == []
@@ -34,7 +32,7 @@ def test_garments_apart_come_out_exactly_as_alone(scene) -> None:
         np.testing.assert_array_equal(animation.rest_pos, alone.rest_pos)
 
 
-def test_layered_garments_stay_layered_and_chunks_agree(scene) -> None:
+def test_layered_garments_stay_layered_and_chunks_agree(scene) -> None:  # noqa: F811
     outfit = garments(scene, 0.17, 0.55)             # the coat 1 cm outside the skirt
     body = scene["body"]
     one = animate_outfit(scene["model"], outfit, body, scene["frames"])
@@ -57,7 +55,7 @@ def test_layered_garments_stay_layered_and_chunks_agree(scene) -> None:
         assert height.min() >= settings.clearance * 0.99
 
 
-def test_the_order_given_is_the_order_used_and_must_name_everyone(scene) -> None:
+def test_the_order_given_is_the_order_used_and_must_name_everyone(scene) -> None:  # noqa: F811
     from gnngarment.geometry.garment_layers import LayerOrderError
 
     outfit = garments(scene, 0.17, 0.55)
@@ -69,7 +67,7 @@ def test_the_order_given_is_the_order_used_and_must_name_everyone(scene) -> None
                        layers=["coat"])
 
 
-def test_the_outfit_glb_has_one_mesh_per_garment_on_one_skeleton(scene, tmp_path) -> None:
+def test_the_outfit_glb_has_one_mesh_per_garment_on_one_skeleton(scene, tmp_path) -> None:  # noqa: F811
     from gnngarment.inference.export.gltf_reader import evaluate_mesh_node, read_glb
     from gnngarment.inference.export.outfit_export import export_outfit
 
