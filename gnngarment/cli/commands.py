@@ -923,7 +923,9 @@ def _animate_outfit(context, paths, out, checkpoint, body_shape, motion, duratio
     except (LayerOrderError, MeshError) as error:
         raise fail(str(error)) from None
     bar.close()
-    console.print("layers (innermost first): "
+    how = ("as given" if layer_names is not None else "read at rest" if result.relations
+           else "no two garments overlap at rest: the order given")
+    console.print(f"layers (innermost first, {how}): "
                   + ", ".join(result.names[index] for index in result.order))
     for index, share in result.penetration.items():
         stats = result.layer_stats.get(index)
