@@ -38,16 +38,20 @@ def run_attribution(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray,
     ``<stem>.json`` (the numbers, also returned).
 
     Args:
-        model: the deformer; pos ``(N, 3)``, faces ``(F, 3)``: the garment in the rest
-            body's frame (metres, Z up).
-        body, frames: the body's shape inputs and its posed motion.
+        model: the deformer.
+        pos: ``(N, 3)`` the garment in the rest body's frame (metres, Z up).
+        faces: ``(F, 3)`` its triangles.
+        body: the body's shape inputs.
+        frames: its posed motion's inputs.
         frame_index: frame of ``frames`` (default: the middle one).
         target: ``vertex``, ``region`` or ``all``.
         vertices: the target vertex (``vertex``; default: the vertex whose output is
             largest) or the region's vertices / centres (``region``).
         radius: for ``region``, grow ``vertices`` to every vertex within this geodesic
             distance (metres).
-        output, reduction, n_steps: see :func:`attribute`.
+        output: see :func:`attribute`.
+        reduction: see :func:`attribute`.
+        n_steps: see :func:`attribute`.
         heat: ``normal`` (the paper's heatmap) or ``all`` channels.
         scale: colour scale of the PNG and PLY, ``linear`` or ``log``.
 

@@ -1,5 +1,6 @@
 """``gnngarment benchmark-accuracy``: train and evaluate ours and the baselines on the same
-data with the same budget, and write the comparison table (docs/results.md).
+data with the same budget, and write the comparison table (into the run folder by
+default; docs/results.md quotes such tables).
 
 An experiment runner, not a metric: it drives the trainer, so it lives beside the CLI
 (which may import everything) rather than in :mod:`gnngarment.evaluation`."""
@@ -96,8 +97,9 @@ def run_benchmark(config: TrainingConfig, output: Path, variants: list[str] | No
 
 def benchmark_command(
     config: Annotated[Path, typer.Option(help="Training YAML shared by every variant.")],
-    output: Annotated[Path, typer.Option(help="Markdown table to write.")
-                      ] = Path("docs/results.md"),
+    output: Annotated[Path | None, typer.Option(
+        help="Markdown table to write (default: benchmark_accuracy.md in the config's run "
+             "folder; never a docs page by default).")] = None,
     variant: Annotated[list[str] | None, typer.Option(help="Only these variants.")] = None,
     split: Annotated[str, typer.Option(help="Evaluated split.")] = "test",
 ) -> None:
@@ -113,11 +115,13 @@ def benchmark_command(
     unknown = [v for v in variant or [] if v not in VARIANTS]
     if unknown:
         raise fail(f"unknown variant(s) {unknown}; choose from {list(VARIANTS)}")
-    check_output_file("--output", output)  # written only after every variant is trained
     try:
         settings = load_training_config(config)
     except (ConfigError, ValueError) as error:
         raise fail(str(error)) from None
+    if output is None:
+        output = Path(settings.output) / "benchmark_accuracy.md"
+    check_output_file("--output", output)  # written only after every variant is trained
     from data_prep.posed_bodies import synthetic_body_meshes, synthetic_skinning_weights
     from gnngarment.data import CacheError
 

@@ -592,10 +592,16 @@ def _lead_in_note(seconds: float, fps: float) -> str:
 def _drape(placed, faces, body_inputs, garment_mesh: Path):
     """``animate --drape``: the garment settled on the rest body, with a progress bar, or
     a clear failure."""
+    return _drape_outfit([placed], [faces], body_inputs, [garment_mesh])[0]
+
+
+def _drape_outfit(placed: list, faces: list, body_inputs, garment_meshes: list[Path]) -> list:
+    """``animate --drape`` of one garment or an outfit (every garment in one simulation),
+    with a progress bar, or a clear failure naming the files."""
     from tqdm import tqdm
 
     from data_prep.simulate import SimulationFailed
-    from gnngarment.inference.placement import drape_on_rest_body
+    from gnngarment.inference.placement import drape_outfit_on_rest_body
 
     bar = tqdm(desc="draping on the rest body", unit="frame")
 
@@ -604,12 +610,12 @@ def _drape(placed, faces, body_inputs, garment_mesh: Path):
         bar.update(done - bar.n)
 
     try:
-        placed = drape_on_rest_body(placed, faces, body_inputs, progress=advance)
+        return drape_outfit_on_rest_body(placed, faces, body_inputs, progress=advance)
     except (ValueError, SimulationFailed) as error:
-        raise fail(f"{garment_mesh}: the drape failed: {error}") from None
+        names = ", ".join(str(path) for path in garment_meshes)
+        raise fail(f"{names}: the drape failed: {error}") from None
     finally:
         bar.close()
-    return placed
 
 
 @app.command()
@@ -617,7 +623,7 @@ def animate(
     context: typer.Context,
     garment_meshes: Annotated[list[Path], typer.Argument(
         help="Garment mesh in the rest body's frame; several garments are animated as one "
-             "outfit (docs/your_own_garment.md, \"Outfits\").")],
+             "outfit (docs/outfits.md).")],
     out: Annotated[Path, typer.Option(help="Output folder.")] = Path("animated"),
     checkpoint: Annotated[Path | None, typer.Option(
         help="Model checkpoint (default: the shipped models/gnngarment-small.pt).")] = None,
@@ -902,10 +908,13 @@ def _animate_outfit(context, paths, out, checkpoint, body_shape, motion, duratio
             console.print(f"[yellow]placement ({name}):[/] {message}")
         placed.append(one)
     lock = _hold_output_folder(context, out) if drape else None
+    if drape:  # every garment in one simulation, with the simulator's self-contact
+        placed = _drape_outfit(placed, [faces for _, _, faces, _ in garments], body_inputs,
+                               [path for _, _, _, path in garments])
+        for (name, *_), one in zip(garments, placed, strict=True):
+            console.print(f"[green]{name}:[/] {one.messages[-1]}")
     outfit = []
     for (name, _, faces, path), one in zip(garments, placed, strict=True):
-        if drape:  # each garment alone; the layer resolution then separates them at rest
-            one = _drape(one, faces, body_inputs, path)
         refuse_misplaced_garment(console, one.pos, faces, body_inputs, path, ignore_placement,
                                  "--source-body, --fix-units/--scale, --up-axis, --offset, "
                                  "or --ignore-placement")

@@ -139,8 +139,8 @@ def animate(model: GarmentDeformer, pos: np.ndarray, faces: np.ndarray, body: Bo
 
     Args:
         model: a trained deformer (eval mode is set here).
-        pos, faces: ``(N, 3)`` garment rest vertices in the rest body's frame (metres,
-            Z up) and ``(F, 3)`` triangles.
+        pos: ``(N, 3)`` garment rest vertices in the rest body's frame (metres, Z up).
+        faces: ``(F, 3)`` triangles.
         body: body-shape inputs (:func:`body_shape_inputs`).
         frames: the posed body's per-frame inputs (:func:`body_motion_inputs`).
         chunk: frames per forward pass; ``None``: :func:`frames_per_chunk` (memory and

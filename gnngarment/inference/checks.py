@@ -248,8 +248,8 @@ def fix_placement(pos: np.ndarray, units: str = "auto", up_axis: str = "z",
             ``body_vertices`` when given; an implausible size is left unscaled).
         up_axis: the garment's up axis, ``"z"`` (nothing to do), ``"y"`` (turned to Z up),
             or ``"auto"`` (:func:`detect_up_axis`; needs ``body_vertices``).
-        body_vertices, body_faces: ``(N_b, 3)`` rest body (and its ``(F_b, 3)`` faces,
-            optional), for the automatic choices.
+        body_vertices: ``(N_b, 3)`` rest body, for the automatic choices.
+        body_faces: its ``(F_b, 3)`` faces (optional).
         scale: metres per file unit, replacing the unit choice (``units`` must then be
             ``"auto"``): for a mesh whose units no rule can guess.
         offset: ``(3,)`` metres added after the scale and the turn (in the rest body's

@@ -102,14 +102,15 @@ def animate_outfit(model: GarmentDeformer, garments: Sequence[OutfitGarment],
     Args:
         model: a trained deformer.
         garments: the outfit (at least one garment; names unique).
-        body, frames: as :func:`~gnngarment.inference.animate.animate`.
+        body: as :func:`~gnngarment.inference.animate.animate`.
+        frames: as :func:`~gnngarment.inference.animate.animate`.
         layers: the order by name, innermost first; ``None``: inferred at rest
             (:func:`~gnngarment.geometry.garment_layers.layer_order`).
         chunk: frames per forward pass (``None``: by the garment's size).
         progress: called with (frames done, total) over all garments.
         resolve_collisions: body and layer resolution (off: the network's output).
-        collisions, layer_settings: body ``ε`` and the layer clearance; defaults
-            :class:`CollisionSettings`, :class:`LayerSettings`.
+        collisions: the body's ``ε`` (default :class:`CollisionSettings`).
+        layer_settings: the layer clearance (default :class:`LayerSettings`).
 
     Raises:
         LayerOrderError: the order cannot be told (names the garments).

@@ -10,7 +10,7 @@ one line per step; :func:`drape_on_rest_body` settles it with the reference simu
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -88,22 +88,58 @@ def drape_on_rest_body(placed: PlacedGarment, faces: np.ndarray, body: BodyShape
         ValueError: the simulator refused the input; SimulationFailed: every attempt
         failed a quality gate.
     """
+    return drape_outfit_on_rest_body([placed], [faces], body, max_frames, progress)[0]
+
+
+def drape_outfit_on_rest_body(placed: Sequence[PlacedGarment], faces: Sequence[np.ndarray],
+                              body: BodyShapeInputs, max_frames: int = 120,
+                              progress: Callable[[int, int], None] | None = None
+                              ) -> list[PlacedGarment]:
+    """Settle several garments on the still rest body together, in one simulation: what
+    ``animate --drape`` does for an outfit. With more than one garment the simulator's
+    cloth self-contact is on, so each garment settles on the ones it touches instead of
+    through them (about 2× the cost of one scene without it); each garment's top band is
+    held as in :func:`drape_on_rest_body`.
+
+    Shapes:
+        placed[i].pos ``(N_i, 3)`` and faces[i] ``(F_i, 3)``; the result in that order.
+
+    Raises:
+        ValueError: the simulator refused the input; SimulationFailed: every attempt
+        failed a quality gate.
+    """
     # Imported here: the simulator (warp, Newton) is heavy and only this step needs it.
-    from data_prep.simulate import drape_garment
+    from data_prep.simulate import SimulationSettings, drape_garment
     from gnngarment.geometry.boundary import support_band
 
+    if len(placed) != len(faces) or not placed:
+        raise ValueError(f"one faces array per garment: {len(placed)} garments, "
+                         f"{len(faces)} faces arrays")
+    starts = np.cumsum([0] + [len(one.pos) for one in placed])
+    scene_pos = np.concatenate([one.pos for one in placed])
+    scene_faces = np.concatenate([np.asarray(f, dtype=np.int64) + start
+                                  for f, start in zip(faces, starts[:-1], strict=True)])
     # As the dataset builder pins a waist ring: a garment hangs from its top band.
-    band = support_band(placed.pos, faces, body.rest_vertices)
-    result = drape_garment(placed.pos, faces, body.rest_vertices, body.faces,
-                           pinned=band if len(band) else None, max_frames=max_frames,
-                           progress=progress)
+    bands = [support_band(one.pos, f, body.rest_vertices)
+             for one, f in zip(placed, faces, strict=True)]
+    pinned = np.concatenate([band + start for band, start in zip(bands, starts[:-1],
+                                                                   strict=True)])
+    settings = SimulationSettings(self_contact=len(placed) > 1)
+    result = drape_garment(scene_pos, scene_faces, body.rest_vertices, body.faces,
+                           pinned=pinned if len(pinned) else None, settings=settings,
+                           max_frames=max_frames, progress=progress)
     state = "settled" if result.settled else f"stopped at the {max_frames}-frame cap"
-    if len(band):
-        state += f", hanging from its top band ({len(band)} vertices held)"
-    return PlacedGarment(
-        pos=result.positions.astype(np.float64), fitted=placed.fitted,
-        seconds={**placed.seconds, "drape": result.seconds},
-        messages=[*placed.messages,
-                  f"draped on the rest body: {state} after {result.frames} frames, "
-                  f"{1000 * result.mean_displacement:.0f} mm mean move "
-                  f"({result.seconds:.1f} s)"])
+    if len(placed) > 1:
+        state += f" with the {len(placed)} garments of the outfit in one scene"
+    draped = []
+    for index, one in enumerate(placed):
+        pos = result.positions[starts[index]:starts[index + 1]].astype(np.float64)
+        moved = float(np.linalg.norm(pos - one.pos, axis=1).mean())
+        held = (f", hanging from its top band ({len(bands[index])} vertices held)"
+                if len(bands[index]) else "")
+        draped.append(PlacedGarment(
+            pos=pos, fitted=one.fitted, seconds={**one.seconds, "drape": result.seconds},
+            messages=[*one.messages,
+                      f"draped on the rest body: {state}{held} after {result.frames} "
+                      f"frames, {1000 * moved:.0f} mm mean move ({result.seconds:.1f} s)"]))
+    return draped

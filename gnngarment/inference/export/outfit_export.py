@@ -69,8 +69,11 @@ def export_outfit(outfit: OutfitAnimation, out_dir: str | Path, name: str = "out
         out_dir: output folder (created).
         name: stem of the outfit's glb, preview and manifest; must differ from every
             garment's name.
-        formats, include_body, progress, max_influences, lock: as
-            :func:`~gnngarment.inference.export.export.export_animation`.
+        formats: as :func:`~gnngarment.inference.export.export.export_animation`.
+        include_body: as ``export_animation`` (the body goes with the innermost garment).
+        progress: as ``export_animation``.
+        max_influences: as ``export_animation``.
+        lock: as ``export_animation``.
 
     Returns:
         Paths by key: ``"glb"``, ``"gif"``/``"mp4"``, ``"manifest"`` and
