@@ -7,9 +7,9 @@ makes and frees dozens of 10-40 MB tensors per pass, and each fresh one pays a p
 fault per 4 KiB page on first touch: measured, a ``(80000, 32) @ (32, 128)`` product took
 18 ms into a fresh tensor and 3.6 ms into a reused one. ``mallopt(M_MMAP_MAX, 0)``
 serves large blocks from the heap instead, and a high ``M_TRIM_THRESHOLD`` keeps freed
-ones there, so the next pass reuses pages already mapped (docs/performance.md,
-"The allocator"). Unlike the ``MALLOC_MMAP_THRESHOLD_`` environment variable this can
-be set at run time, so every ``gnngarment`` command sets it at start.
+ones there, so the next pass reuses pages already mapped (docs/experiments/
+2026-12-03-speed-issue14.md, item 10). Unlike the ``MALLOC_MMAP_THRESHOLD_``
+environment variable this can be set at run time, so every ``gnngarment`` command sets it at start.
 
 The cost: memory freed by the process stays mapped, up to :data:`TRIM_THRESHOLD`
 above what it uses (its peak resident memory is what it would have been). A library

@@ -4,8 +4,8 @@ the machine has.
 Intra-op parallel operators wait for their slowest thread. With another process busy
 on one of two cores, a second thread is descheduled most of the time and every
 operator waits for it: measured 10-40x slower than one thread at batch 1
-(docs/performance.md, "Threads"). So a run counts the cores other processes leave idle
-(a short sample of ``/proc/stat``) and uses that many, at least one.
+(docs/experiments/2026-12-02-speed-threads-skinning-size.md). So a run counts the cores
+other processes leave idle (a short sample of ``/proc/stat``) and uses that many, at least one.
 """
 
 from __future__ import annotations

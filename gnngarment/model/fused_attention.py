@@ -68,7 +68,7 @@ _ARCH_FLAGS = (["-march=native"], [])
 #: What ``auto`` uses where autograd records the forward (training): on the shipped
 #: training recipe the fused path measured 1.09x (supervised), 1.14x (physics) and 1.17x
 #: (physics + strain) the PyTorch path's frames/s, mean of six rounds on 2 AMD EPYC cores
-#: (docs/performance.md, "Fused graph-attention operator").
+#: (docs/performance.md, "Current figures"; docs/experiments/2026-12-06-speed-fused-attention.md).
 AUTO_UNDER_AUTOGRAD = "fused"
 #: Seconds a compile may take before it counts as failed.
 _COMPILE_TIMEOUT = 600

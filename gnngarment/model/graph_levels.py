@@ -84,9 +84,10 @@ class GraphLevels:
 
 #: Garment hierarchies whose attention graphs (with their layouts and transposes, built
 #: on first use) are kept between calls: a training run sees the same garments batch
-#: after batch, and rebuilding them was ~20 % of a supervised step (docs/performance.md,
-#: item 11). Least recently used first out; a 10,000-vertex skirt's structures (3 levels,
-#: 4 and 24 heads, with the transposes training builds) measured 90 MB, hence the bound.
+#: after batch, and rebuilding them was ~20 % of a supervised step (docs/experiments/
+#: 2026-12-03-speed-issue14.md, item 11). Least recently used first out; a 10,000-vertex
+#: skirt's structures (3 levels, 4 and 24 heads, with the transposes training builds)
+#: measured 90 MB, hence the bound.
 CACHED_HIERARCHIES = 32
 _level_graphs: OrderedDict[int, tuple[weakref.ref, dict]] = OrderedDict()
 
