@@ -158,7 +158,9 @@ def main() -> None:
         "Every number below was printed by the command above it in this one run; the "
         "steps ran one after the other. Interpretation, targets and what was optimised: "
         "[performance.md](performance.md) (inference), [geometry.md](geometry.md) "
-        "(preparation), [simulation.md](simulation.md) (the simulator).\n\n"
+        "(preparation), [simulation.md](simulation.md) (the simulator). This page is one "
+        "run's snapshot: the current figures are the dated ones at the top of "
+        "performance.md, which win where the two differ.\n\n"
         + (f"**Failed steps: {', '.join(failures)}.**\n\n" if failures else ""))
     atomic_write_bytes(args.out, (header + "\n".join(log)).encode())
     print(f"\nwrote {args.out} ({total / 60:.1f} min)")
