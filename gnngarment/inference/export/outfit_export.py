@@ -127,7 +127,8 @@ def export_outfit(outfit: OutfitAnimation, out_dir: str | Path, name: str = "out
                     merged_animation([animation for _, animation in ordered]),
                     out / f"{name}.{preview}", include_body=include_body,
                     progress=None if progress is None
-                    else (lambda done, total, kind=preview: progress(kind, done, total)))
+                    else (lambda done, total, kind=preview: progress(kind, done, total)),
+                    garment_faces=[len(animation.faces) for _, animation in ordered])
         manifest["files"] = {key: path.name if path.parent == out else
                              str(path.relative_to(out)) for key, path in paths.items()}
         paths["manifest"] = atomic_write_bytes(out / f"{name}_export.json",

@@ -11,7 +11,7 @@ ramp per material) so the GIF needs no colour quantisation.
 from __future__ import annotations
 
 import io
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -24,18 +24,24 @@ from gnngarment.io.atomic import atomic_write_bytes
 if TYPE_CHECKING:
     from gnngarment.inference.animate import Animation
 
-GARMENT_RGB = np.array([0.85, 0.33, 0.25])
+#: Garment colours: a single garment is the first; an outfit's garments alternate, so
+#: each garment stands out from the one it is worn over.
+GARMENT_RGB = (np.array([0.85, 0.33, 0.25]), np.array([0.25, 0.47, 0.80]))
 BODY_RGB = np.array([0.72, 0.72, 0.72])
-#: Shade levels per material in the 256-colour palette (garment, body; last is white).
-LEVELS = 127
+#: Shade levels per material in the 256-colour palette (two garment colours, the body;
+#: the last index is the white background).
+LEVELS = 85
+BODY_OFFSET = len(GARMENT_RGB) * LEVELS
+BACKGROUND = BODY_OFFSET + LEVELS
 AMBIENT = 0.3
 
 
 def palette() -> np.ndarray:
-    """``(256, 3)`` uint8: garment shades 0..126, body shades 127..253, white 254-255."""
+    """``(256, 3)`` uint8: the shades of each garment colour (0..84, 85..169), of the body
+    (170..254), then white (255)."""
     shades = AMBIENT + (1 - AMBIENT) * np.arange(LEVELS) / (LEVELS - 1)
-    colours = np.concatenate([shades[:, None] * GARMENT_RGB, shades[:, None] * BODY_RGB,
-                              np.ones((2, 3))])
+    colours = np.concatenate([shades[:, None] * rgb for rgb in (*GARMENT_RGB, BODY_RGB)]
+                             + [np.ones((256 - BACKGROUND, 3))])
     return np.round(255 * colours).astype(np.uint8)
 
 
@@ -87,7 +93,8 @@ def cluster_decimation(frames: np.ndarray, faces: np.ndarray, max_faces: int = 4
 def render_preview(animation: Animation, path: str | Path, *, size: int = 288,
                    max_frames: int = 48, include_body: bool = True, max_body_faces: int = 4000,
                    azimuth: float = 30.0, elevation: float = 12.0, supersample: int = 1,
-                   progress: Callable[[int, int], None] | None = None) -> Path:
+                   progress: Callable[[int, int], None] | None = None,
+                   garment_faces: Sequence[int] | None = None) -> Path:
     """Write an animated GIF (or MP4, if ``imageio-ffmpeg`` is installed) of the garment
     (coloured) on the body (grey), atomically.
 
@@ -105,6 +112,8 @@ def render_preview(animation: Animation, path: str | Path, *, size: int = 288,
         supersample: anti-aliasing factor (rendered at ``size × supersample``, averaged;
             2 looks smoother and costs ~4× the time).
         progress: called with (frames rendered, total).
+        garment_faces: for an outfit drawn as one animation, the number of faces of each
+            garment in ``faces`` order; consecutive garments get alternating colours.
 
     Returns:
         ``path``.
@@ -115,15 +124,21 @@ def render_preview(animation: Animation, path: str | Path, *, size: int = 288,
         raise ValueError(f"{path}: preview must be .gif or .mp4")
     chosen, duration = preview_frames(len(animation.posed), animation.fps, max_frames)
     # (frames, faces, palette offset of the material, two-sided)
-    meshes = [(np.asarray(animation.posed, dtype=np.float64)[chosen],
-               np.asarray(animation.faces, dtype=np.int64), 0, True)]
+    posed = np.asarray(animation.posed, dtype=np.float64)[chosen]
+    faces = np.asarray(animation.faces, dtype=np.int64)
+    counts = [len(faces)] if garment_faces is None else [int(c) for c in garment_faces]
+    if sum(counts) != len(faces) or min(counts) < 0:
+        raise ValueError(f"garment_faces {counts} must add up to the {len(faces)} faces")
+    starts = np.cumsum([0, *counts])
+    meshes = [(posed, faces[starts[k]:starts[k + 1]], (k % len(GARMENT_RGB)) * LEVELS, True)
+              for k in range(len(counts)) if counts[k]]
     if include_body:
         body_all = np.asarray(animation.body_vertices, dtype=np.float64)[chosen]
         labels, body_faces = cluster_decimation(body_all, animation.body_faces, max_body_faces)
         counts = np.bincount(labels)
         body = np.stack([np.stack([np.bincount(labels, frame[:, a]) / counts
                                    for a in range(3)], axis=1) for frame in body_all])
-        meshes.append((body, body_faces, LEVELS, False))
+        meshes.append((body, body_faces, BODY_OFFSET, False))
     right, up, forward = _camera(azimuth, elevation)
     light = _normalised(-forward + 0.6 * up - 0.4 * right)
     # Fixed framing from everything drawn, over all frames.
@@ -153,7 +168,7 @@ def render_preview(animation: Animation, path: str | Path, *, size: int = 288,
             depths.append(corners @ forward)
             levels.append(offset + lit[keep] * (LEVELS - 1))  # palette index, per corner
         level = rasterize(np.concatenate(triangles), np.concatenate(depths),
-                          np.concatenate(levels), pixels, background=2 * LEVELS)
+                          np.concatenate(levels), pixels, background=BACKGROUND)
         indices.append(np.round(level).astype(np.uint8))
         if progress is not None:
             progress(k + 1, len(chosen))

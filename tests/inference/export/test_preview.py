@@ -43,6 +43,23 @@ def test_gif_shows_the_garment_in_colour_on_a_grey_body(tmp_path: Path) -> None:
             & (alone[0].reshape(-1, 3).max(axis=1) < 235)).mean() < greyish
 
 
+def test_an_outfit_shows_each_garment_in_its_own_colour(tmp_path: Path) -> None:
+    """Two garments drawn as one animation: the first red, the second blue."""
+    animation = synthetic_animation(frames=2)
+    half = len(animation.faces) // 2
+    path = render_preview(animation, tmp_path / "o.gif", size=128, include_body=False,
+                          garment_faces=[half, len(animation.faces) - half])
+    pixels = iio.imread(path, index=None)[0].reshape(-1, 3).astype(int)
+    reddish = (pixels[:, 0] - pixels[:, 2] > 60).mean()
+    bluish = (pixels[:, 2] - pixels[:, 0] > 60).mean()
+    assert reddish > 0.01 and bluish > 0.01
+    one = iio.imread(render_preview(animation, tmp_path / "one.gif", size=128,
+                                    include_body=False), index=None)[0].reshape(-1, 3)
+    assert ((one[:, 2].astype(int) - one[:, 0]) > 60).mean() == 0  # alone: no blue
+    with pytest.raises(ValueError, match="add up"):
+        render_preview(animation, tmp_path / "x.gif", garment_faces=[1])
+
+
 def test_rasterizer_matches_brute_force_nearest_triangle() -> None:
     rng = np.random.default_rng(0)
     size, count = 40, 30
