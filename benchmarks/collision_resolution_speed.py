@@ -46,6 +46,22 @@ SKIRTS = {"loose": (0.17, 0.30), "tight": (0.15, 0.20)}
 BATCH = 16
 
 
+def shipped_model_walking(frames: int, fps: float = 30.0):
+    """The shipped model, Anny's 'average' body and its inputs walking for ``frames``
+    frames at ``fps``: the scene of this benchmark and of layer_resolution_speed.py.
+
+    Returns:
+        ``(model, body, frames)``: the deformer, body-shape inputs, body-motion inputs.
+    """
+    model = load_model(SHIPPED_MODEL)
+    body_model = AnnyBodyModel()
+    shape = body_model.parse_shape("average")
+    body = body_shape_inputs(body_model, shape, model.config.body_vertices)
+    motion = load_motion("walk", fps=fps, duration=frames / fps)
+    return model, body, body_motion_inputs(body_model, shape, motion,
+                                           model.config.body_vertices)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--vertices", type=int, default=5000)
@@ -55,13 +71,7 @@ def main() -> None:
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
     settings = CollisionSettings()
-    model = load_model(SHIPPED_MODEL)
-    body_model = AnnyBodyModel()
-    shape = body_model.parse_shape("average")
-    body = body_shape_inputs(body_model, shape, model.config.body_vertices)
-    fps = 30.0
-    motion = load_motion("walk", fps=fps, duration=args.frames / fps)
-    frames = body_motion_inputs(body_model, shape, motion, model.config.body_vertices)
+    model, body, frames = shipped_model_walking(args.frames)
     count = len(frames.vertices)
     print(f"{SHIPPED_MODEL.name}, Anny 'average' walking, {count} frames, batch {BATCH}, "
           f"torch threads {args.threads} (Warp: one core), best of {args.repeats}; "

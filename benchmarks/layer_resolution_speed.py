@@ -34,9 +34,8 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from benchmarks.collision_resolution_speed import shipped_model_walking  # noqa: E402
 from data_prep.garments.skirt import flared_skirt  # noqa: E402
-from gnngarment.body import AnnyBodyModel, load_motion  # noqa: E402
-from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs  # noqa: E402
 from gnngarment.geometry.garment_layers import (  # noqa: E402
     LayerSettings,
     layer_penetration,
@@ -45,7 +44,6 @@ from gnngarment.geometry.garment_layers import (  # noqa: E402
 )
 from gnngarment.inference.animate import animate  # noqa: E402
 from gnngarment.inference.outfit import OutfitGarment, animate_outfit  # noqa: E402
-from gnngarment.model.checkpoint import load_model  # noqa: E402
 from gnngarment.paths import SHIPPED_MODEL  # noqa: E402
 
 BATCH = 16
@@ -63,13 +61,7 @@ def main() -> None:
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
     settings = LayerSettings()
-    model = load_model(SHIPPED_MODEL)
-    body_model = AnnyBodyModel()
-    shape = body_model.parse_shape("average")
-    body = body_shape_inputs(body_model, shape, model.config.body_vertices)
-    fps = 30.0
-    motion = load_motion("walk", fps=fps, duration=args.frames / fps)
-    frames = body_motion_inputs(body_model, shape, motion, model.config.body_vertices)
+    model, body, frames = shipped_model_walking(args.frames)
     count = len(frames.vertices)
     print(f"{SHIPPED_MODEL.name}, Anny 'average' walking, {count} frames, batch {BATCH}, "
           f"torch threads {args.threads} (Warp: one core), best of {args.repeats}; "
