@@ -589,6 +589,20 @@ def _lead_in_note(seconds: float, fps: float) -> str:
             f"the motion starts at frame {count}")
 
 
+def _place(pos, faces, body_inputs, units: str, up_axis: str, scale: float | None,
+           offset, source, named: Path):
+    """``place_garment`` with the command's options, or a clear failure naming ``named``
+    (the source body when one is given, else the garment file)."""
+    from gnngarment.inference.placement import place_garment
+
+    try:
+        return place_garment(pos, faces, body_inputs, units=units, up_axis=up_axis,
+                             scale=scale, offset=None if offset is None else list(offset),
+                             source_body=source)
+    except ValueError as error:
+        raise fail(f"{named}: {error}") from None
+
+
 def _drape(placed, faces, body_inputs, garment_mesh: Path):
     """``animate --drape``: the garment settled on the rest body, with a progress bar, or
     a clear failure."""
@@ -689,7 +703,6 @@ def animate(
     from gnngarment.inference.animate import animate as run_animation
     from gnngarment.inference.animation_memory import animation_memory_problem
     from gnngarment.inference.export import export_animation
-    from gnngarment.inference.placement import place_garment
     from gnngarment.model.checkpoint import load_model
     from gnngarment.paths import SHIPPED_MODEL
 
@@ -719,12 +732,8 @@ def animate(
     if problem:
         raise fail(problem)
     body_inputs = body_shape_inputs(body_model, shape, model.config.body_vertices)
-    try:
-        placed = place_garment(pos, faces, body_inputs, units=fix_units, up_axis=up_axis,
-                               scale=scale, offset=None if offset is None else list(offset),
-                               source_body=source)
-    except ValueError as error:
-        raise fail(f"{source_body or garment_mesh}: {error}") from None
+    placed = _place(pos, faces, body_inputs, fix_units, up_axis, scale, offset, source,
+                    source_body or garment_mesh)
     # The output folder is taken before the long work: the drape, else the inference (a
     # garment refused by the placement check then leaves no folder or lock file behind).
     lock = _hold_output_folder(context, out) if drape else None
@@ -859,7 +868,6 @@ def _animate_outfit(context, paths, out, checkpoint, body_shape, motion, duratio
     from gnngarment.inference.export.outfit_export import export_outfit, outfit_paths
     from gnngarment.inference.outfit import OutfitGarment, animate_outfit
     from gnngarment.inference.output_folder import check_outputs_spare_inputs
-    from gnngarment.inference.placement import place_garment
     from gnngarment.model.checkpoint import load_model
     from gnngarment.paths import SHIPPED_MODEL
 
@@ -898,12 +906,8 @@ def _animate_outfit(context, paths, out, checkpoint, body_shape, motion, duratio
     body_inputs = body_shape_inputs(body_model, shape, model.config.body_vertices)
     placed = []
     for name, pos, faces, path in garments:
-        try:
-            one = place_garment(pos, faces, body_inputs, units=fix_units, up_axis=up_axis,
-                                scale=scale, offset=None if offset is None else list(offset),
-                                source_body=source)
-        except ValueError as error:
-            raise fail(f"{source_body or path}: {error}") from None
+        one = _place(pos, faces, body_inputs, fix_units, up_axis, scale, offset, source,
+                     source_body or path)
         for message in one.messages:
             console.print(f"[yellow]placement ({name}):[/] {message}")
         placed.append(one)
