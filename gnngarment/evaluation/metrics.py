@@ -78,25 +78,24 @@ def collision_rate(pred: np.ndarray, body_points: np.ndarray, body_normals: np.n
 
 def mesh_collision_rate(pred: np.ndarray, body_vertices: np.ndarray,
                         body_faces: np.ndarray) -> np.ndarray:
-    """Percentage of garment vertices inside the posed body **mesh** per frame: the
-    exact signed distance (warp's mesh query, the one collision resolution uses) is
-    negative. :func:`collision_rate`'s nearest-sample normal misjudges vertices a few
-    millimetres outside concave regions (armpits, crotch) as inside; this does not.
+    """Percentage of garment vertices inside the posed body **mesh** per frame: its
+    winding number there is at least 1 (warp's BVH ray casts, as collision resolution
+    tests it). :func:`collision_rate`'s nearest-sample normal misjudges vertices a few
+    millimetres outside concave regions (armpits, crotch) as inside; this does not. The
+    winding number counts a vertex where two body parts overlap (winding 2: an arm sunk
+    into the chest) as inside, where a ray's crossing parity (the measure before
+    2026-12-07) counted it outside.
 
     Shapes: pred ``(T, N, 3)``, body_vertices ``(T, N_b, 3)``, body_faces ``(F_b, 3)``.
     """
-    from gnngarment.geometry.signed_distance import (
-        refit_mesh,
-        signed_distance_warp,
-        warp_mesh,
-    )
+    from gnngarment.geometry.signed_distance import refit_mesh, warp_mesh, winding_numbers
 
     mesh = warp_mesh(body_vertices[0], body_faces)
     rates = np.empty(len(pred))
     for t in range(len(pred)):
         if t:
             refit_mesh(mesh, body_vertices[t])
-        rates[t] = 100.0 * (signed_distance_warp(mesh, pred[t]) < 0).mean()
+        rates[t] = 100.0 * (winding_numbers(mesh, pred[t]) >= 1).mean()
     return rates
 
 

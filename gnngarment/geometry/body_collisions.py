@@ -15,6 +15,14 @@ its own push along its own direction throughout; then every moved vertex that ma
 come too close is checked again and, if the spread pushed it inside or too close
 elsewhere, projected out once more (no spreading): no vertex ends closer than ``ε``.
 
+Inside means a winding number of at least 1 (one ray's signed crossings), not the
+closest face's side: the posed body intersects itself (the upper arm sinks into the
+chest with the arms down), and there a vertex in the chest can have its closest point on
+the buried arm surface, which the pseudo-normal calls "outside". Such a vertex — inside,
+with its closest point still inside just past that surface — is moved along the
+shortest of 64 rays out of the union of the parts instead
+(:meth:`BodyCollider._signed`).
+
 The body must be a closed mesh with outward winding (inside/outside is undefined
 otherwise): the body models give the body's largest connected component
 (:class:`~gnngarment.body.anny_model.AnnyBodyModel` drops Anny's tongue and eyes).
@@ -23,7 +31,7 @@ Cost: one Warp mesh per call, refit per frame (not rebuilt); closest points are 
 only within ``search_band`` of the surface. A vertex farther away is outside or deep
 inside; every vertex of a connected far region has the same status (an edge shorter
 than twice the band cannot cross the surface between two far vertices), so one
-ray-parity test per region decides it (benchmarks/collision_resolution_speed.py).
+winding-number ray per region decides it (benchmarks/collision_resolution_speed.py).
 """
 
 from __future__ import annotations
@@ -34,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from gnngarment.geometry.graph import edge_index_from_faces
+from gnngarment.geometry.signed_distance import sphere_directions
 
 
 @dataclass
@@ -80,6 +89,15 @@ class CollisionStats:
 
 #: Relative slack on ``ε`` when checking the result (float32 queries).
 _ACCEPT = 1e-3
+#: How far past its closest surface point a point inside is tested for a buried
+#: surface [m] (:meth:`BodyCollider._signed`).
+_BURIED_STEP = 1e-4
+
+
+#: The rays searched for the way out where the closest surface is buried: 64 directions,
+#: about 26° apart, so the shortest found is within ~4 % of the true shortest exit of a
+#: flat surface (the re-check passes then move the vertex to ε along that surface's normal).
+_EXIT_RAYS = sphere_directions(64)
 
 
 class PushGraph:
@@ -159,9 +177,9 @@ class BodyCollider:
         import scipy.sparse as sp
         from scipy.sparse.csgraph import connected_components
 
-        from gnngarment.geometry.signed_distance import inside_by_parity, surface_offsets
+        from gnngarment.geometry.signed_distance import surface_offsets, winding_numbers
 
-        distance, _, direction = surface_offsets(self.mesh, pos, self.band)
+        distance, direction = self._signed(pos, *surface_offsets(self.mesh, pos, self.band))
         far = ~np.isfinite(distance)
         if not far.any():
             return distance, direction
@@ -177,12 +195,10 @@ class BodyCollider:
         _, labels = connected_components(graph, directed=False)
         regions, first = np.unique(labels[far], return_index=True)
         representatives = np.flatnonzero(far)[first]
-        deep = regions[inside_by_parity(self.mesh, pos[representatives])]
+        deep = regions[winding_numbers(self.mesh, pos[representatives]) >= 1]
         if len(deep):
             inside = far & np.isin(labels, deep)
-            depth, _, outward = surface_offsets(self.mesh, pos[inside], inside=np.ones(
-                int(inside.sum()), dtype=bool))
-            distance[inside], direction[inside] = depth, outward
+            distance[inside], direction[inside] = self._deep(pos[inside])
         return distance, direction
 
     def offsets_of(self, pos: np.ndarray, moved: np.ndarray, was_far: np.ndarray,
@@ -191,20 +207,68 @@ class BodyCollider:
 
         A vertex that was outside and farther than the band and moved less than twice
         the band cannot be deeper than the band inside now; any other vertex with no
-        surface within the band is classified by parity.
+        surface within the band is classified by its winding number.
         """
-        from gnngarment.geometry.signed_distance import inside_by_parity, surface_offsets
+        from gnngarment.geometry.signed_distance import surface_offsets, winding_numbers
 
         points = pos[moved]
-        distance, _, direction = surface_offsets(self.mesh, points, self.band)
+        distance, direction = self._signed(points, *surface_offsets(self.mesh, points, self.band))
         unsure = ~np.isfinite(distance) & ~(was_far[moved] & (push[moved] < 2 * self.band))
         if unsure.any():
             inside = np.zeros(len(points), dtype=bool)
-            inside[unsure] = inside_by_parity(self.mesh, points[unsure])
+            inside[unsure] = winding_numbers(self.mesh, points[unsure]) >= 1
             if inside.any():
-                depth, _, outward = surface_offsets(self.mesh, points[inside],
-                                                    inside=np.ones(int(inside.sum()), bool))
-                distance[inside], direction[inside] = depth, outward
+                distance[inside], direction[inside] = self._deep(points[inside])
+        return distance, direction
+
+    def _deep(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`_signed` offsets of points known to be inside, farther than the band."""
+        from gnngarment.geometry.signed_distance import surface_offsets
+
+        found = surface_offsets(self.mesh, points, inside=np.ones(len(points), dtype=bool))
+        return self._signed(points, *found)
+
+    def _signed(self, points: np.ndarray, distance: np.ndarray, closest: np.ndarray,
+                direction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The closest-point offsets of ``points (N, 3)`` (``surface_offsets``), signed by
+        the winding number instead of the pseudo-normal, and the way out of the union
+        where the closest surface is buried.
+
+        The posed body intersects itself (an upper arm sunk into the chest, thighs
+        pressed together): there the closest body point of a point inside may lie on
+        a part's surface that is itself inside another part. The pseudo-normal then
+        calls the point outside, and moving it to that surface leaves it inside; such
+        a point gets the shortest ray out of the union instead
+        (:func:`~gnngarment.geometry.signed_distance.union_exits`), its length as the
+        depth. Points with no surface within the band (``inf``) are kept.
+        """
+        from gnngarment.geometry.signed_distance import union_exits, winding_numbers
+
+        near = np.flatnonzero(np.isfinite(distance))
+        if not len(near):
+            return distance, direction
+        distance, direction = distance.copy(), direction.copy()
+        winding = winding_numbers(self.mesh, points[near])
+        inside = winding >= 1
+        length = np.abs(distance[near])
+        toward = closest[near] - points[near]          # to the closest surface point
+        on_surface = length < 1e-7
+        unit = toward / np.where(on_surface, 1.0, length)[:, None]
+        outward = np.where(inside[:, None], unit, -unit)
+        outward[on_surface] = direction[near][on_surface]   # the face normal
+        distance[near] = np.where(inside, -length, length)
+        direction[near] = outward
+        # Inside, and just past the closest surface point still inside: buried.
+        check = near[inside]
+        beyond = closest[check] + outward[inside] * _BURIED_STEP
+        buried = winding_numbers(self.mesh, beyond) >= 1
+        if buried.any():
+            which = check[buried]
+            depth, way = union_exits(self.mesh, points[which], winding[inside][buried],
+                                     _EXIT_RAYS)
+            found = np.isfinite(depth)
+            distance[which[found]] = -depth[found]
+            direction[which[found]] = way[found]
         return distance, direction
 
 

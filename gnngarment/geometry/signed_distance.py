@@ -13,7 +13,11 @@ compiled on first use and cached on disk):
   the outward direction to it, searched within a given distance (points farther away
   cost almost nothing), signed by the angle-weighted pseudo-normal unless the caller
   already knows the point is inside; :func:`inside_by_parity` — one ray's crossing
-  parity. :mod:`~gnngarment.geometry.body_collisions` combines the two.
+  parity; :func:`winding_numbers` — one ray's signed crossings, right where the posed
+  body intersects itself (an arm sunk into the chest: parity calls the overlap
+  outside); :func:`union_exits` — the shortest of many rays out of the union of the
+  body's parts, where the closest surface is a buried one.
+  :mod:`~gnngarment.geometry.body_collisions` combines them.
 
 A mesh that moves (the posed body, frame after frame) is built once with
 :func:`warp_mesh` and refit with :func:`refit_mesh`.
@@ -136,13 +140,78 @@ def _kernels() -> dict[str, Any]:
         ray = wp.normalize(wp.vec3(0.5773, 0.5774, 0.5775))
         origin = points[tid]
         crossings = wp.int32(0)
+        last = wp.int32(-1)
         for _ in range(1024):
             hit = wp.mesh_query_ray(mesh, origin, ray, 1.0e3)
             if not hit.result:
                 break
-            crossings += 1
+            if hit.face != last:  # not the face just left, found again past it
+                crossings += 1
+            last = hit.face
             origin = origin + ray * (hit.t + 1.0e-6)
         inside[tid] = wp.int8(crossings % 2)
+
+    @wp.func
+    def crossing(mesh: wp.uint64, face: int, ray: wp.vec3) -> int:
+        # +1 where the ray leaves the mesh's inside through the face (outward winding),
+        # -1 where it enters.
+        if wp.dot(wp.mesh_eval_face_normal(mesh, face), ray) > 0.0:
+            return 1
+        return -1
+
+    @wp.kernel
+    def winding(mesh: wp.uint64, points: wp.array(dtype=wp.vec3), out: wp.array(dtype=wp.int32)):
+        # The winding number of a closed mesh at a point is the signed count of one ray's
+        # crossings (exits − entries): 1 inside one part, 2 where two parts overlap.
+        tid = wp.tid()
+        ray = wp.normalize(wp.vec3(0.5773, 0.5774, 0.5775))
+        origin = points[tid]
+        total = wp.int32(0)
+        last = wp.int32(-1)
+        for _ in range(1024):
+            hit = wp.mesh_query_ray(mesh, origin, ray, 1.0e3)
+            if not hit.result:
+                break
+            # A ray grazing an edge finds the face it just crossed again a step past it
+            # (float32): that is no second crossing.
+            if hit.face != last:
+                total += crossing(mesh, hit.face, ray)
+            last = hit.face
+            origin = origin + ray * (hit.t + 1.0e-6)
+        out[tid] = total
+
+    @wp.kernel
+    def union_exits(mesh: wp.uint64, points: wp.array(dtype=wp.vec3),
+                    start: wp.array(dtype=wp.int32), rays: wp.array(dtype=wp.vec3),
+                    exit_length: wp.array(dtype=float), exit_ray: wp.array(dtype=wp.vec3)):
+        # Along each ray, the first point where the winding number (``start`` at the
+        # point) falls to 0: where the ray leaves the union of the mesh's parts. The
+        # shortest of them over all rays, and its ray.
+        tid = wp.tid()
+        best = float(wp.inf)
+        best_ray = wp.vec3(0.0, 0.0, 0.0)
+        for r in range(rays.shape[0]):
+            ray = rays[r]
+            origin = points[tid]
+            travelled = wp.float32(0.0)
+            number = start[tid]
+            last = wp.int32(-1)
+            for _ in range(1024):
+                hit = wp.mesh_query_ray(mesh, origin, ray, best - travelled)
+                if not hit.result:
+                    break
+                travelled += hit.t
+                if hit.face != last:  # the face just crossed, found again: no crossing
+                    number -= crossing(mesh, hit.face, ray)
+                last = hit.face
+                if number <= 0:
+                    best = travelled
+                    best_ray = ray
+                    break
+                origin = origin + ray * (hit.t + 1.0e-6)
+                travelled += 1.0e-6
+        exit_length[tid] = best
+        exit_ray[tid] = best_ray
 
     @wp.kernel
     def side_offsets(mesh: wp.uint64, points: wp.array(dtype=wp.vec3), max_dist: float,
@@ -169,7 +238,7 @@ def _kernels() -> dict[str, Any]:
             alignment[tid] = 0.0
 
     return {"signed_distance": signed_distance, "offsets": offsets, "parity": parity,
-            "side_offsets": side_offsets}
+            "winding": winding, "union_exits": union_exits, "side_offsets": side_offsets}
 
 
 def signed_distance_warp(mesh: Any, points: np.ndarray) -> np.ndarray:
@@ -256,6 +325,70 @@ def inside_by_parity(mesh: Any, points: np.ndarray) -> np.ndarray:
                   inputs=[mesh.id, wp.array(points, dtype=wp.vec3, device="cpu"), inside],
                   device="cpu")
     return inside.numpy().astype(bool)
+
+
+def winding_numbers(mesh: Any, points: np.ndarray) -> np.ndarray:
+    """``(N,)`` int32: the winding number of the closed ``mesh`` at ``points (N, 3)``
+    (the signed crossings of one ray; same cost as :func:`inside_by_parity`).
+
+    Unlike the parity, it stays right where the mesh intersects itself (a posed body's
+    arm pressed into its chest): 1 inside one part, 2 inside two overlapping parts, 0
+    outside. A point is inside the body when it is ``>= 1``.
+    """
+    wp = import_warp()
+    points = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
+    out = wp.zeros(len(points), dtype=wp.int32, device="cpu")
+    if len(points):
+        wp.launch(_kernels()["winding"], dim=len(points),
+                  inputs=[mesh.id, wp.array(points, dtype=wp.vec3, device="cpu"), out],
+                  device="cpu")
+    return out.numpy().copy()
+
+
+def sphere_directions(count: int) -> np.ndarray:
+    """``(count, 3)`` float32 unit vectors spread evenly over the sphere (a Fibonacci
+    lattice; neighbours about ``3.6 / sqrt(count)`` radians apart)."""
+    k = np.arange(count) + 0.5
+    z = 1.0 - 2.0 * k / count
+    azimuth = np.pi * (1.0 + 5.0 ** 0.5) * k
+    ring = np.sqrt(1.0 - z * z)
+    return np.stack([ring * np.cos(azimuth), ring * np.sin(azimuth), z], 1).astype(np.float32)
+
+
+def union_exits(mesh: Any, points: np.ndarray, winding: np.ndarray, rays: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """The shortest way out of a self-intersecting closed mesh, over a set of rays.
+
+    Where parts of a mesh overlap (a posed body's upper arm sunk into its chest), the
+    closest surface point of a point inside may be a buried one — on the arm, inside
+    the chest — and moving to it leaves the point inside. Along each ray this finds
+    the first point where the winding number falls to 0 (the outside of the union of
+    the parts) and keeps the shortest.
+
+    Args:
+        mesh: a closed ``warp.Mesh`` on the CPU (outward winding).
+        points: ``(N, 3)`` [m], inside (``winding >= 1``).
+        winding: ``(N,)`` their winding numbers (:func:`winding_numbers`).
+        rays: ``(K, 3)`` unit directions (e.g. :func:`sphere_directions`).
+
+    Returns:
+        length ``(N,)`` [m] (``inf`` where no ray leaves) and the ray ``(N, 3)`` it
+        was found along, float32.
+    """
+    wp = import_warp()
+    points = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
+    count = len(points)
+    length = wp.empty(count, dtype=float, device="cpu")
+    direction = wp.empty(count, dtype=wp.vec3, device="cpu")
+    if count:
+        wp.launch(_kernels()["union_exits"], dim=count,
+                  inputs=[mesh.id, wp.array(points, dtype=wp.vec3, device="cpu"),
+                          wp.array(np.ascontiguousarray(winding, dtype=np.int32),
+                                   dtype=wp.int32, device="cpu"),
+                          wp.array(np.ascontiguousarray(rays, dtype=np.float32),
+                                   dtype=wp.vec3, device="cpu"), length, direction],
+                  device="cpu")
+    return length.numpy().copy(), direction.numpy().reshape(count, 3).copy()
 
 
 def side_offsets(mesh: Any, points: np.ndarray, max_dist: float

@@ -10,7 +10,7 @@ from gnngarment.geometry.body_collisions import (
     spread_pushes,
 )
 from gnngarment.geometry.graph import adjacency_matrix, edge_index_from_faces
-from gnngarment.geometry.signed_distance import signed_distance
+from gnngarment.geometry.signed_distance import signed_distance, warp_mesh, winding_numbers
 from tests.meshes import box_signed_distance, closed_box, grid
 
 HALF = np.array([0.2, 0.15, 0.3])
@@ -145,3 +145,24 @@ def test_bad_inputs_are_refused_with_the_expected_shape() -> None:
         resolve_collisions(pos, faces, body, body_faces.astype(float))
     with pytest.raises(ValueError, match="must not be negative"):
         resolve_collisions(pos, faces, body, body_faces, CollisionSettings(epsilon=-1.0))
+
+
+def test_vertices_by_a_buried_surface_are_moved_out_of_every_part() -> None:
+    """Where the body intersects itself (a small sphere sunk into a big one, like an
+    upper arm in the chest), a vertex inside the big part but just outside the small one
+    has a buried closest surface: seen from it the vertex is outside. It must still end
+    ε outside the union."""
+    from tests.geometry.test_signed_distance import sunk_spheres
+
+    body, body_faces = sunk_spheres()
+    # A patch 5 mm off the small sphere's far side (x = 0.255), inside the big sphere.
+    pos, faces = sheet(-0.1, 21, 0.0)
+    pos = pos[:, [2, 0, 1]] + [0.255, 0.0, 0.0]   # the plane x = 0.255, 0.2 × 0.2 m
+    mesh = warp_mesh(body, body_faces)
+    inside = winding_numbers(mesh, pos) >= 1
+    assert inside.all()
+    resolved, stats = resolve_collisions(pos, faces, body, body_faces)
+    assert (winding_numbers(warp_mesh(body, body_faces), resolved) == 0).all()
+    assert stats.inside[0] == len(pos) and stats.remaining[0] == 0
+    # out through the big sphere, not deeper in: every vertex ends outside its radius
+    assert (np.linalg.norm(resolved, axis=1) >= 0.3 - 1e-3).all()
