@@ -41,6 +41,11 @@ class DataConfig:
         extra_train_garments: further train designs, drawn after the canonical plan
             from a generator of their own, so adding them keeps every design, body,
             motion and split the config had (the same validation and test sequences).
+        extra_val_garments, extra_test_garments: further held-out designs, drawn the
+            same way after the extra train designs (numbered after them: growing
+            ``extra_train_garments`` later renames these), each paired with the split's
+            bodies and held-out motions like the canonical ones, so a split can grow
+            without changing training or the sequences it had.
         garment_vertices: [min, max] target vertex count of a garment.
         bodies: body shapes in total; named presets are used first, then samples.
         body_presets: Anny presets to use first.
@@ -90,6 +95,8 @@ class DataConfig:
         "skirt", "dress", "jumpsuit", "tshirt", "trousers", "top"])
     garments: int = 12
     extra_train_garments: int = 0
+    extra_val_garments: int = 0
+    extra_test_garments: int = 0
     garment_vertices: list[int] = field(default_factory=lambda: [900, 1500])
     bodies: int = 4
     body_presets: list[str] = field(default_factory=list)
@@ -168,9 +175,9 @@ class DataConfig:
                              "test_subjects")
         if subjects and not self.motion_files:
             raise ValueError("key 'splits': val_subjects/test_subjects need motion_files")
-        if self.extra_train_garments < 0:
-            raise ValueError("key 'extra_train_garments': must be >= 0, got "
-                             f"{self.extra_train_garments}")
+        for key in ("extra_train_garments", "extra_val_garments", "extra_test_garments"):
+            if getattr(self, key) < 0:
+                raise ValueError(f"key '{key}': must be >= 0, got {getattr(self, key)}")
         if self.motion_variants > self.motions_per_pair:
             raise ValueError(f"key 'motion_variants': {self.motion_variants} variants need at "
                              f"least as many motions per pair, got {self.motions_per_pair}")

@@ -23,6 +23,7 @@ BUILDER_VERSION = 1
 #: effect on a sequence is all in its plan (hashed with it), so changing them (e.g. more
 #: motions per pair) keeps every sequence and drape already built.
 PLAN_KEYS = ("seed", "garment_types", "garments", "extra_train_garments",
+             "extra_val_garments", "extra_test_garments",
              "garment_vertices", "bodies",
              "body_presets", "motions", "motions_per_pair", "motion_variants", "fabrics",
              "splits", "motion_files", "motion_window_seconds", "windows_per_clip",

@@ -121,7 +121,7 @@ def plan_dataset(config: DataConfig) -> list[SequencePlan]:
     train_clips = [m for m in clips if m.split == "train"]
     held_out_clips = {split: [m for m in clips if m.split == split] for split in ("val", "test")}
     next_clip = {"train": 0, "val": 0, "test": 0}
-    designs += _extra_train_designs(config)
+    designs += _extra_designs(config)
 
     sequences = []
     for design in designs:
@@ -192,19 +192,30 @@ def _clip_motions(config: DataConfig) -> list[MotionPlan]:
     return motions
 
 
-def _extra_train_designs(config: DataConfig) -> list[DesignPlan]:
-    """The config's ``extra_train_garments`` designs, numbered after the canonical ones
-    and drawn from a generator of their own (seeded by the config seed), so the draws
-    of the canonical plan — designs, motion seeds, splits — stay as they were."""
-    rng = np.random.default_rng([config.seed, 1 << 20])  # not any canonical draw
+def _extra_designs(config: DataConfig) -> list[DesignPlan]:
+    """The config's ``extra_train_garments``, then ``extra_val_garments``, then
+    ``extra_test_garments`` designs, numbered after the canonical ones and drawn from
+    generators of their own (seeded by the config seed and the split), so the draws of
+    the canonical plan — designs, motion seeds, splits — stay as they were, and so do
+    each split's extra designs when another split's count changes (only their numbers
+    follow the train extras)."""
     low, high = config.garment_vertices
+    counts = {"train": config.extra_train_garments, "val": config.extra_val_garments,
+              "test": config.extra_test_garments}
     designs = []
-    for k in range(config.garments, config.garments + config.extra_train_garments):
-        garment_type = config.garment_types[k % len(config.garment_types)]
-        designs.append(DesignPlan(
-            name=f"{garment_type}{k:03d}", garment_type=garment_type,
-            seed=int(rng.integers(1 << 30)), vertices=int(rng.integers(low, high + 1)),
-            fabric=config.fabrics[k % len(config.fabrics)], split="train"))
+    k = config.garments
+    for index, (split, count) in enumerate(counts.items()):
+        # [seed, 1 << 20] is the train extras' generator since before the held-out ones
+        # existed (their designs must not change); the others add the split's index.
+        key = [config.seed, 1 << 20] + ([index] if index else [])
+        rng = np.random.default_rng(key)  # not any canonical draw
+        for _ in range(count):
+            garment_type = config.garment_types[k % len(config.garment_types)]
+            designs.append(DesignPlan(
+                name=f"{garment_type}{k:03d}", garment_type=garment_type,
+                seed=int(rng.integers(1 << 30)), vertices=int(rng.integers(low, high + 1)),
+                fabric=config.fabrics[k % len(config.fabrics)], split=split))
+            k += 1
     return designs
 
 

@@ -60,3 +60,32 @@ def test_extra_train_garments_keep_every_planned_sequence(tmp_path: Path) -> Non
     assert len({p.design.seed for p in added}) == grown.extra_train_garments
     with pytest.raises(ValueError, match="extra_train_garments"):
         replace(config, extra_train_garments=-1)
+
+
+def test_extra_held_out_garments_grow_their_split_only(tmp_path: Path) -> None:
+    """More validation and test designs (``extra_val_garments``, ``extra_test_garments``)
+    keep every sequence the config had, train extras included, and add sequences of
+    their own split only, each on a body of that split, with a held-out motion."""
+    from data_prep.simulate import load_simulation_settings
+
+    config = replace(tiny_config(tmp_path), extra_train_garments=2)
+    grown = replace(config, extra_val_garments=2, extra_test_garments=3)
+    settings = load_simulation_settings(config.simulation)
+    before = plan_dataset(config)
+    after = plan_dataset(grown)
+    assert after[:len(before)] == before
+    assert ([sequence_inputs_hash(content_inputs(grown, settings), p) for p in before]
+            == [sequence_inputs_hash(content_inputs(config, settings), p) for p in before])
+    added = after[len(before):]
+    assert {p.split for p in added} == {"val", "test"}
+    assert all(p.body.split == p.split and p.motion.split == p.split for p in added)
+    designs = {split: {p.design.name for p in added if p.split == split}
+               for split in ("val", "test")}
+    assert (len(designs["val"]), len(designs["test"])) == (2, 3)
+    assert not (designs["val"] | designs["test"]) & {p.design.name for p in before}
+    # a split's extra designs do not depend on another split's count
+    fewer_test = plan_dataset(replace(config, extra_val_garments=2, extra_test_garments=1))
+    assert ([p.design.seed for p in fewer_test if p.split == "val" and p not in before]
+            == [p.design.seed for p in added if p.split == "val"])
+    with pytest.raises(ValueError, match="extra_test_garments"):
+        replace(config, extra_test_garments=-1)
