@@ -102,8 +102,10 @@ class TrainingConfig:
         initial_weights: a model checkpoint whose weights start a new run (fine-tuning,
             e.g. adding ``model.dynamics_modes`` to a trained model); the parts of this
             model it has no weights for (the oscillators) keep their initialisation,
-            every other weight must fit. Empty: a fresh initialisation. Ignored when a
-            run resumes (its own checkpoint has every weight).
+            every other weight must fit. ``null`` (the default) or empty: a fresh
+            initialisation (``--set initial_weights=null`` starts a config that names
+            weights from scratch). Ignored when a run resumes (its own checkpoint has
+            every weight).
     """
 
     data: str = "data/paper"
@@ -120,7 +122,7 @@ class TrainingConfig:
     threads: int = 0
     validate_every: int = 1
     deterministic: bool = True
-    initial_weights: str = ""
+    initial_weights: str | None = None
 
     def __post_init__(self) -> None:
         """Check ranges before any work starts (``epochs: 0`` would report a checkpoint

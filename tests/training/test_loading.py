@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from gnngarment.config import ConfigError
-from gnngarment.paths import default_config
+from gnngarment.paths import REPOSITORY_ROOT, default_config
 from gnngarment.training.config import TrainingConfig
 from gnngarment.training.loading import load_training_config
 
@@ -43,3 +43,12 @@ def test_bad_configs_are_named(tmp_path: Path, text: str, overrides, message: st
     path.write_text(text)
     with pytest.raises((ConfigError, ValueError), match=message):
         load_training_config(path, overrides)
+
+
+@pytest.mark.parametrize("override", ["initial_weights=null", "initial_weights="])
+def test_a_fine_tune_config_can_start_from_scratch(override: str) -> None:
+    """``--set initial_weights=null`` turns a config that names starting weights into a
+    run from a fresh initialisation (no edited copy of the file needed)."""
+    config = REPOSITORY_ROOT / "configs/train/cmu_dynamics.yaml"
+    assert load_training_config(config).initial_weights
+    assert not load_training_config(config, [override]).initial_weights
