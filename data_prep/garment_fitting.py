@@ -84,3 +84,12 @@ def read_pins(root: Path, garment: str) -> tuple[np.ndarray, int]:
     """The pinned vertices ``(P,)`` of a cache garment and the joint they follow."""
     pins = json.loads((root / "garments" / f"{garment}.pins.json").read_text())
     return np.asarray(pins["vertices"], dtype=np.int64), int(pins["joint"])
+
+
+def pin_targets(rest_pos: np.ndarray, pinned: np.ndarray, joint: int,
+                joint_transforms: np.ndarray) -> np.ndarray:
+    """Where the pinned vertices are every frame: a waist ring or top band follows its
+    joint rigidly. Shapes: rest_pos ``(N, 3)`` [m], pinned ``(P,)``, joint_transforms
+    ``(T, 24, 4, 4)`` → ``(T, P, 3)`` [m]."""
+    rest = np.concatenate([rest_pos[pinned], np.ones((len(pinned), 1))], 1)
+    return np.einsum("tab,pb->tpa", joint_transforms[:, joint], rest)[..., :3]

@@ -14,7 +14,7 @@ import numpy as np
 from data_prep.bodies import anny_body_model, anny_shape
 from data_prep.build_records import crashed, left_out
 from data_prep.config import DataConfig
-from data_prep.garment_fitting import read_pins
+from data_prep.garment_fitting import pin_targets, read_pins
 from data_prep.left_the_body import left_the_body
 from data_prep.plan import SequencePlan, planned_motion
 from gnngarment.io.atomic import atomic_write_bytes
@@ -46,18 +46,15 @@ def simulate_sequence(task: tuple[str, SequencePlan, DataConfig, str]) -> dict[s
         transforms = posed.joint_transforms.numpy()
         garment = read_garment(root, plan.garment)
         pinned, pin_joint = read_pins(root, plan.garment)
-        pin_targets = None
-        if len(pinned):
-            # A waist ring or top band follows its joint rigidly.
-            rest_h = np.concatenate([garment.rest_pos[pinned], np.ones((len(pinned), 1))], 1)
-            pin_targets = np.einsum("tab,pb->tpa", transforms[:, pin_joint], rest_h)[..., :3]
+        targets = (pin_targets(garment.rest_pos, pinned, pin_joint, transforms)
+                   if len(pinned) else None)
         settings = load_simulation_settings(config.simulation)
         if config.settle_frames >= 0:
             settings.settle_frames = config.settle_frames
         result = simulate_garment(garment.rest_pos, garment.faces, body_vertices,
                                   body_model.faces, config.fps, fabric=plan.design.fabric,
                                   pinned=pinned if len(pinned) else None,
-                                  pin_targets=pin_targets, settings=settings)
+                                  pin_targets=targets, settings=settings)
         velocities = body_model.subset_velocities(posed, config.fps, config.body_vertices).numpy()
         samples = body_model.feature_vertex_indices(config.collision_points)
         normals = np.stack([vertex_normals(v, body_model.faces)[samples] for v in body_vertices])

@@ -133,24 +133,6 @@ def _kernels() -> dict[str, Any]:
         closest[tid] = point
         direction[tid] = wp.vec3(0.0, 0.0, 0.0)
 
-    @wp.kernel
-    def parity(mesh: wp.uint64, points: wp.array(dtype=wp.vec3), inside: wp.array(dtype=wp.int8)):
-        # Surface crossings of one ray, in a direction no body axis lines up with.
-        tid = wp.tid()
-        ray = wp.normalize(wp.vec3(0.5773, 0.5774, 0.5775))
-        origin = points[tid]
-        crossings = wp.int32(0)
-        last = wp.int32(-1)
-        for _ in range(1024):
-            hit = wp.mesh_query_ray(mesh, origin, ray, 1.0e3)
-            if not hit.result:
-                break
-            if hit.face != last:  # not the face just left, found again past it
-                crossings += 1
-            last = hit.face
-            origin = origin + ray * (hit.t + 1.0e-6)
-        inside[tid] = wp.int8(crossings % 2)
-
     @wp.func
     def crossing(mesh: wp.uint64, face: int, ray: wp.vec3) -> int:
         # +1 where the ray leaves the mesh's inside through the face (outward winding),
@@ -160,12 +142,15 @@ def _kernels() -> dict[str, Any]:
         return -1
 
     @wp.kernel
-    def winding(mesh: wp.uint64, points: wp.array(dtype=wp.vec3), out: wp.array(dtype=wp.int32)):
-        # The winding number of a closed mesh at a point is the signed count of one ray's
-        # crossings (exits − entries): 1 inside one part, 2 where two parts overlap.
+    def crossings(mesh: wp.uint64, points: wp.array(dtype=wp.vec3),
+                  count: wp.array(dtype=wp.int32), winding: wp.array(dtype=wp.int32)):
+        # The surface crossings of one ray, in a direction no body axis lines up with:
+        # their number (its parity: inside a closed mesh) and their signed sum (exits −
+        # entries: the winding number, 1 inside one part, 2 where two parts overlap).
         tid = wp.tid()
         ray = wp.normalize(wp.vec3(0.5773, 0.5774, 0.5775))
         origin = points[tid]
+        number = wp.int32(0)
         total = wp.int32(0)
         last = wp.int32(-1)
         for _ in range(1024):
@@ -175,10 +160,12 @@ def _kernels() -> dict[str, Any]:
             # A ray grazing an edge finds the face it just crossed again a step past it
             # (float32): that is no second crossing.
             if hit.face != last:
+                number += 1
                 total += crossing(mesh, hit.face, ray)
             last = hit.face
             origin = origin + ray * (hit.t + 1.0e-6)
-        out[tid] = total
+        count[tid] = number
+        winding[tid] = total
 
     @wp.kernel
     def union_exits(mesh: wp.uint64, points: wp.array(dtype=wp.vec3),
@@ -237,8 +224,8 @@ def _kernels() -> dict[str, Any]:
             normal[tid] = wp.vec3(0.0, 0.0, 0.0)
             alignment[tid] = 0.0
 
-    return {"signed_distance": signed_distance, "offsets": offsets, "parity": parity,
-            "winding": winding, "union_exits": union_exits, "side_offsets": side_offsets}
+    return {"signed_distance": signed_distance, "offsets": offsets, "crossings": crossings,
+            "union_exits": union_exits, "side_offsets": side_offsets}
 
 
 def signed_distance_warp(mesh: Any, points: np.ndarray) -> np.ndarray:
@@ -314,17 +301,23 @@ def surface_offsets(mesh: Any, points: np.ndarray, max_dist: float = SEARCH_RADI
             direction.numpy().reshape(count, 3).copy())
 
 
+def _ray_crossings(mesh: Any, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The number and the signed sum of one ray's surface crossings from each point."""
+    wp = import_warp()
+    points = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
+    count = wp.zeros(len(points), dtype=wp.int32, device="cpu")
+    winding = wp.zeros(len(points), dtype=wp.int32, device="cpu")
+    if len(points):
+        wp.launch(_kernels()["crossings"], dim=len(points),
+                  inputs=[mesh.id, wp.array(points, dtype=wp.vec3, device="cpu"), count,
+                          winding], device="cpu")
+    return count.numpy().copy(), winding.numpy().copy()
+
+
 def inside_by_parity(mesh: Any, points: np.ndarray) -> np.ndarray:
     """``(N,)`` bool: ``points (N, 3)`` inside the closed ``mesh`` by the parity of the
     surface crossings of one ray (costs a few BVH ray casts per point)."""
-    wp = import_warp()
-    points = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
-    inside = wp.zeros(len(points), dtype=wp.int8, device="cpu")
-    if len(points):
-        wp.launch(_kernels()["parity"], dim=len(points),
-                  inputs=[mesh.id, wp.array(points, dtype=wp.vec3, device="cpu"), inside],
-                  device="cpu")
-    return inside.numpy().astype(bool)
+    return _ray_crossings(mesh, points)[0] % 2 == 1
 
 
 def winding_numbers(mesh: Any, points: np.ndarray) -> np.ndarray:
@@ -335,14 +328,7 @@ def winding_numbers(mesh: Any, points: np.ndarray) -> np.ndarray:
     arm pressed into its chest): 1 inside one part, 2 inside two overlapping parts, 0
     outside. A point is inside the body when it is ``>= 1``.
     """
-    wp = import_warp()
-    points = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
-    out = wp.zeros(len(points), dtype=wp.int32, device="cpu")
-    if len(points):
-        wp.launch(_kernels()["winding"], dim=len(points),
-                  inputs=[mesh.id, wp.array(points, dtype=wp.vec3, device="cpu"), out],
-                  device="cpu")
-    return out.numpy().copy()
+    return _ray_crossings(mesh, points)[1]
 
 
 def sphere_directions(count: int) -> np.ndarray:
