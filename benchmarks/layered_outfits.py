@@ -20,7 +20,7 @@ Newton's answer, of our raw output and after resolution; each garment's E_verts 
 against Newton's outfit) as an outfit and, for the top, alone.
 
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/layered_outfits.py [--data data/benchmark_cmu]
-        [--config configs/data/benchmark_cmu.yaml] [--outfits 8]
+        [--config configs/data/benchmark_cmu.yaml] [--outfits 6] [--motions all]
 
 Issue 40's bars: penetration after resolution ≤ Newton's own; each garment's E_verts as
 an outfit within +2 % of resolving it alone.
@@ -71,11 +71,14 @@ BOTTOMS = ("trousers", "skirt")
 TOPS = ("tshirt", "top")
 
 
-def outfits(config: DataConfig, count: int, clips: bool) -> list[tuple[object, object, object]]:
-    """``(bottom plan, top plan, sequence plan)`` per outfit and motion: test designs on
-    the same test body, bottoms and tops paired in turn, on the held-out motions of the
-    bottom's test sequences (procedural, and with ``clips`` its CMU windows too)."""
-    tests = [p for p in plan_dataset(config) if p.split == "test"]
+def outfits(config: DataConfig, root: Path, count: int, motions: str
+            ) -> list[tuple[object, object, object]]:
+    """``(bottom plan, top plan, sequence plan)`` per outfit and motion: test designs
+    draped on the same test body (a design whose drape the build left out is skipped),
+    bottoms and tops paired in turn, on the held-out motions of the bottom's test
+    sequences (``motions``: ``procedural``, ``clips`` — its CMU windows — or ``all``)."""
+    tests = [p for p in plan_dataset(config) if p.split == "test"
+             and (root / "garments" / f"{p.garment}.npz").is_file()]
     plans = [p for p in tests if not p.motion.is_clip]
     by_body: dict[str, dict[str, list]] = {}
     for plan in plans:
@@ -89,7 +92,8 @@ def outfits(config: DataConfig, count: int, clips: bool) -> list[tuple[object, o
         for bottom, top in zip(kinds["bottom"], kinds["top"], strict=False):
             chosen.append((bottom, top))
     return [(bottom, top, plan) for bottom, top in chosen[:count] for plan in tests
-            if plan.garment == bottom.garment and (clips or not plan.motion.is_clip)]
+            if plan.garment == bottom.garment
+            and motions in ("all", "clips" if plan.motion.is_clip else "procedural")]
 
 
 def cpu_model() -> str:
@@ -128,12 +132,12 @@ def main() -> None:
     parser.add_argument("--data", type=Path, default=ROOT / "data/benchmark_cmu")
     parser.add_argument("--config", type=Path, default=ROOT / "configs/data/benchmark_cmu.yaml")
     parser.add_argument("--outfits", type=int, default=6)
-    parser.add_argument("--procedural-only", action="store_true",
-                        help="only the held-out procedural motion, not the CMU windows")
+    parser.add_argument("--motions", choices=("all", "procedural", "clips"), default="all",
+                        help="the held-out procedural motion, the CMU windows, or both")
     args = parser.parse_args()
     torch.set_num_threads(1)
     config = load_config(args.config, DataConfig)
-    chosen = outfits(config, args.outfits, clips=not args.procedural_only)
+    chosen = outfits(config, args.data, args.outfits, args.motions)
     if not chosen:
         sys.exit(f"error: {args.config}: no test body has both a bottom and a top design")
     model = load_model(SHIPPED_MODEL)
