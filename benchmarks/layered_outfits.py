@@ -217,8 +217,12 @@ def main() -> None:
               f"{row['resolved']:.2f} % | {row['bottom']:.1f} / {row['bottom_skinning']:.1f} | "
               f"{row['top_outfit']:.1f} / {row['top_alone']:.1f} / {row['top_skinning']:.1f} |",
               flush=True)
+    if not totals:
+        sys.exit("error: Newton left out every outfit sequence (the stretch gate)")
     mean = {key: float(np.mean(values)) for key, values in totals.items()}
-    print(f"| **mean of {len(chosen)}** | | | | {mean['newton']:.2f} % | {mean['raw']:.2f} % | "
+    simulated = len(totals["newton"])
+    print(f"| **mean of {simulated} of {len(chosen)}** | | | | {mean['newton']:.2f} % | "
+          f"{mean['raw']:.2f} % | "
           f"{mean['resolved']:.2f} % | {mean['bottom']:.1f} / {mean['bottom_skinning']:.1f} | "
           f"{mean['top_outfit']:.1f} / {mean['top_alone']:.1f} / {mean['top_skinning']:.1f} |")
     print(f"penetration after resolution ≤ Newton's: "
