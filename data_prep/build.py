@@ -42,9 +42,11 @@ from data_prep.inputs_hash import (
     BUILDER_VERSION,
     content_inputs,
     garment_inputs_hash,
+    outfit_inputs_hash,
     sequence_inputs_hash,
 )
-from data_prep.plan import BodyPlan, DesignPlan, plan_dataset
+from data_prep.outfit_worker import simulate_outfit
+from data_prep.plan import BodyPlan, DesignPlan, plan_dataset, plan_outfits
 from data_prep.sequence_worker import simulate_sequence
 from gnngarment.io.atomic import FolderLock, atomic_write_bytes
 
@@ -75,7 +77,7 @@ def build_dataset(config: DataConfig, workers: int | None = None,
 
 
 #: The folders a build writes (stale temporary files are looked for only there).
-CACHE_FOLDERS = ("raw", "garments", "sequences", "topologies", "bodies", ".")
+CACHE_FOLDERS = ("raw", "garments", "sequences", "outfits", "topologies", "bodies", ".")
 
 
 def _build_locked(root: Path, config: DataConfig, workers: int | None,
@@ -161,6 +163,9 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
                 results.append(result)
                 if not result["ok"]:
                     log(f"sequence {result['name']} left out: {result['reason']}")
+        failed_outfits: dict[str, str] = {}
+        outfits = _build_outfits(root, config, plans, failed_garments, base_hash, executor,
+                                 log, failed_outfits)
     # A worker killed mid-write (and retried) left a hidden temporary file; every worker
     # has stopped, so it is stale.
     lock.remove_stale_temporaries(CACHE_FOLDERS)
@@ -186,13 +191,14 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
             sequences[plan.name]["frames"] = read_sequence(root, plan.name).num_frames
     manifest = write_manifest(root, splits, sequences, extra={
         "builder_version": BUILDER_VERSION, "config": asdict(config),
-        "fabric_density": 0.2})
+        "fabric_density": 0.2, "outfits": outfits})
     report = {
         "output": str(root), "seconds": time.perf_counter() - started,
         "planned": len(plans), "skipped_existing": skipped, "simulated": len(results),
         "failed_sequences": failed, "failed_garments": failed_garments,
         "losses_by_reason": losses_by_reason(failed, failed_garments, plans),
         "splits": {k: len(v) for k, v in splits.items()},
+        "outfits": len(outfits), "failed_outfits": failed_outfits,
         "seconds_per_frame": float(np.mean([r["seconds_per_frame"] for r in results
                                             if r["ok"]])) if any(r["ok"] for r in results)
         else None,
@@ -200,6 +206,47 @@ def _build_locked(root: Path, config: DataConfig, workers: int | None,
     }
     atomic_write_bytes(root / "build_report.json", json.dumps(report, indent=2).encode())
     return report
+
+
+def _build_outfits(root: Path, config: DataConfig, plans: list, failed_garments: dict,
+                   base_hash: dict, executor, log: Callable[[str], None],
+                   failed: dict[str, str]) -> dict[str, dict[str, Any]]:
+    """Simulate the planned layered outfits (:func:`data_prep.plan.plan_outfits`) whose
+    garments were draped and whose bottom's sequence was built; return the manifest's
+    ``outfits`` (per built outfit: split, sequence, garments innermost first) and put
+    in ``failed`` why the others were left out."""
+    from tqdm import tqdm
+
+    planned = plan_outfits(config, plans)
+    if not planned:
+        return {}
+    tasks, ready = [], []
+    for plan in planned:
+        if (any(g in failed_garments for g in plan.garments)
+                or not (root / "sequences" / f"{plan.sequence.name}.npz").is_file()):
+            failed[plan.name] = "a garment's drape or the bottom's sequence was left out"
+            continue
+        inputs_hash = outfit_inputs_hash(base_hash, plan)
+        reason = known_failure(root, plan.name, inputs_hash, folder="outfits")
+        if sequence_done(root, plan.name, inputs_hash, folder="outfits"):
+            ready.append(plan)
+        elif reason is not None:
+            failed[plan.name] = reason
+        else:
+            tasks.append((str(root), plan, config, inputs_hash))
+    log(f"{len(planned)} outfits planned: {len(ready)} already built, {len(tasks)} to "
+        "simulate (every garment of one in one scene)")
+    built = {plan.name for plan in ready}
+    results = executor.imap_unordered(simulate_outfit, tasks, lost=lost_task) if tasks else []
+    for result in tqdm(results, total=len(tasks), desc="outfits", unit="outfit"):
+        if result["ok"]:
+            built.add(result["name"])
+        else:
+            failed[result["name"]] = result["reason"]
+            log(f"outfit {result['name']} left out: {result['reason']}")
+    return {plan.name: {"split": plan.sequence.split, "sequence": plan.sequence.name,
+                        "garments": list(plan.garments)}
+            for plan in planned if plan.name in built}
 
 
 def _warm_up_kernels(log: Callable[[str], None]) -> None:

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from data_prep.garment_fitting import read_pins
-from data_prep.plan import SequencePlan
+from data_prep.plan import OutfitPlan, SequencePlan
 from gnngarment.io.atomic import atomic_write_bytes
 
 
@@ -85,18 +85,20 @@ def garment_summary(root: Path, name: str) -> dict[str, Any]:
             "drape_mean_displacement_mm": 1000 * float(shift)}
 
 
-def sequence_done(root: Path, name: str, inputs_hash: str) -> bool:
-    hash_file = root / "sequences" / f"{name}.hash"
-    return ((root / "sequences" / f"{name}.npz").is_file() and hash_file.is_file()
+def sequence_done(root: Path, name: str, inputs_hash: str, folder: str = "sequences") -> bool:
+    """Whether a sequence (``folder="outfits"``: an outfit) is built with these inputs."""
+    hash_file = root / folder / f"{name}.hash"
+    return ((root / folder / f"{name}.npz").is_file() and hash_file.is_file()
             and hash_file.read_text() == inputs_hash
-            and _intact_npz(root / "sequences" / f"{name}.npz"))
+            and _intact_npz(root / folder / f"{name}.npz"))
 
 
 def lost_task(task: tuple, error: Exception) -> dict[str, Any]:
     """The status of a task whose worker process died more often than Ray retries it:
     left out of this build, not recorded as failed (the next build tries it again)."""
     plan = task[1]
-    name = plan.name if isinstance(plan, SequencePlan) else f"{plan.name}_{task[2].name}"
+    name = (plan.name if isinstance(plan, SequencePlan | OutfitPlan)
+            else f"{plan.name}_{task[2].name}")
     return {"name": name, "ok": False, "reason": f"worker lost: {type(error).__name__}",
             "seconds": math.nan}
 

@@ -86,6 +86,12 @@ class DataConfig:
         ray_address: the Ray cluster to join with ``executor: ray`` (``auto``,
             ``HOST:6379``, ``ray://HOST:10001``); empty: the one ``RAY_ADDRESS`` names,
             else one started with ``ray start`` on this machine, else a new Ray here.
+        outfits: layered test outfits to simulate besides the sequences (0: none): a
+            test bottom (trousers, skirt) and a test top (T-shirt, top) draped on the
+            same test body, both garments in one Newton scene on each held-out motion
+            of the bottom's test sequences (:func:`data_prep.plan.plan_outfits`);
+            ``gnngarment evaluate`` reports them per garment and by inter-garment
+            penetration (docs/outfits.md).
         splits: held-out counts.
     """
 
@@ -124,6 +130,7 @@ class DataConfig:
     workers: int = 0
     executor: str = "local"
     ray_address: str = ""
+    outfits: int = 0
     splits: SplitConfig = field(default_factory=SplitConfig)
 
     def __post_init__(self) -> None:
@@ -175,7 +182,8 @@ class DataConfig:
                              "test_subjects")
         if subjects and not self.motion_files:
             raise ValueError("key 'splits': val_subjects/test_subjects need motion_files")
-        for key in ("extra_train_garments", "extra_val_garments", "extra_test_garments"):
+        for key in ("extra_train_garments", "extra_val_garments", "extra_test_garments",
+                    "outfits"):
             if getattr(self, key) < 0:
                 raise ValueError(f"key '{key}': must be >= 0, got {getattr(self, key)}")
         if self.motion_variants > self.motions_per_pair:

@@ -14,7 +14,7 @@ from dataclasses import asdict
 from typing import Any
 
 from data_prep.config import DataConfig
-from data_prep.plan import CLIP_FIELDS, BodyPlan, DesignPlan, SequencePlan
+from data_prep.plan import CLIP_FIELDS, BodyPlan, DesignPlan, OutfitPlan, SequencePlan
 
 #: Bumped when the builder's output changes for the same config (forces a rebuild).
 BUILDER_VERSION = 1
@@ -27,7 +27,7 @@ PLAN_KEYS = ("seed", "garment_types", "garments", "extra_train_garments",
              "garment_vertices", "bodies",
              "body_presets", "motions", "motions_per_pair", "motion_variants", "fabrics",
              "splits", "motion_files", "motion_window_seconds", "windows_per_clip",
-             "lead_in_seconds", "hold_seconds", "held_out_motions_per_pair")
+             "lead_in_seconds", "hold_seconds", "held_out_motions_per_pair", "outfits")
 #: Config keys that decide nothing a worker computes.
 PLACE_KEYS = ("output", "workers", "simulation", "executor", "ray_address")
 
@@ -55,6 +55,13 @@ def sequence_inputs_hash(inputs: dict[str, Any], plan: SequencePlan) -> str:
 def garment_inputs_hash(inputs: dict[str, Any], design: DesignPlan, body: BodyPlan) -> str:
     """The hash a draped garment (``design`` fitted to ``body``) is recorded with."""
     return _hash({**inputs, "design": asdict(design), "body": asdict(body)})
+
+
+def outfit_inputs_hash(inputs: dict[str, Any], plan: OutfitPlan) -> str:
+    """The hash a built outfit is recorded with: its bottom's sequence plan and its top's
+    design (the bodies, motion and drapes follow from them)."""
+    return _hash({**inputs, "outfit": {"sequence": asdict(plan.sequence),
+                                       "top": asdict(plan.top)}})
 
 
 def _hash(payload: Any) -> str:

@@ -78,6 +78,52 @@ class SequencePlan:
         return f"{self.design.name}_{self.body.name}"
 
 
+#: Garment types worn under another (the inner layer of an outfit) and over one.
+BOTTOM_TYPES = ("trousers", "skirt")
+TOP_TYPES = ("tshirt", "top")
+
+
+@dataclass(frozen=True)
+class OutfitPlan:
+    """A layered outfit of the test split: the ``top`` design's garment worn over the
+    bottom's, on the body and motion of one of the bottom's test sequences
+    (``sequence``, which gives the outfit its motion inputs)."""
+
+    sequence: SequencePlan
+    top: DesignPlan
+
+    @property
+    def name(self) -> str:
+        return f"{self.sequence.name}+{self.top.name}"
+
+    @property
+    def garments(self) -> tuple[str, str]:
+        """The cache garments, innermost first."""
+        return self.sequence.garment, f"{self.top.name}_{self.sequence.body.name}"
+
+
+def plan_outfits(config: DataConfig, plans: list[SequencePlan] | None = None
+                 ) -> list[OutfitPlan]:
+    """The ``config.outfits`` layered outfits of a build: on each test body in turn, its
+    test bottoms (:data:`BOTTOM_TYPES`) and tops (:data:`TOP_TYPES`) paired in order,
+    each pair on every held-out motion of the bottom's test sequences (so the outfit
+    and the bottom alone are simulated on the same motion). Deterministic in
+    ``config``; ``plans`` is :func:`plan_dataset`'s result where already at hand."""
+    if config.outfits == 0:
+        return []
+    tests = [p for p in (plans if plans is not None else plan_dataset(config))
+             if p.split == "test"]
+    pairs: list[tuple[DesignPlan, DesignPlan, str]] = []
+    for body in dict.fromkeys(p.body.name for p in tests):
+        designs = list({p.design.name: p.design for p in tests if p.body.name == body}.values())
+        bottoms = [d for d in designs if d.garment_type in BOTTOM_TYPES]
+        tops = [d for d in designs if d.garment_type in TOP_TYPES]
+        pairs += [(bottom, top, body) for bottom, top in zip(bottoms, tops, strict=False)]
+    return [OutfitPlan(sequence, top) for bottom, top, body in pairs[:config.outfits]
+            for sequence in tests
+            if sequence.design == bottom and sequence.body.name == body]
+
+
 def _assign(count: int, val: int, test: int) -> list[str]:
     """Split labels for ``count`` items: the last ``test`` are test, the ``val`` before
     them validation, the rest train."""

@@ -22,6 +22,8 @@ import numpy as np
 MATCH_TOLERANCE = 0.001
 
 BodyMesh = tuple[np.ndarray, np.ndarray]
+#: ``(BodyShapeInputs, BodyMotionInputs)`` of one sequence.
+BodyInputs = tuple
 
 
 def synthetic_body_meshes(root: str | Path) -> Callable[[str], BodyMesh | None]:
@@ -31,6 +33,40 @@ def synthetic_body_meshes(root: str | Path) -> Callable[[str], BodyMesh | None]:
 
     Anny is constructed on the first call (about a second with its cache in place).
     """
+    reposed, _ = _reposer(root)
+
+    def body_mesh(name: str) -> BodyMesh | None:
+        found = reposed(name)
+        return None if found is None else (found[3], found[0].faces)
+
+    return body_mesh
+
+
+def synthetic_body_inputs(root: str | Path) -> Callable[[str], BodyInputs | None]:
+    """``sequence name →`` the model's body inputs for that sequence's body and motion,
+    made as ``animate`` makes them (``(BodyShapeInputs, BodyMotionInputs)``,
+    :mod:`gnngarment.data.body_inputs`): what animating a cache's outfits needs; ``None``
+    as :func:`synthetic_body_meshes`."""
+    from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs
+
+    reposed, count = _reposer(root)
+
+    def body_inputs(name: str) -> BodyInputs | None:
+        found = reposed(name)
+        if found is None:
+            return None
+        model, shape, motion, _ = found
+        return (body_shape_inputs(model, shape, count),
+                body_motion_inputs(model, shape, motion, count))
+
+    return body_inputs
+
+
+def _reposer(root: str | Path) -> tuple[Callable[[str], tuple | None], int]:
+    """``sequence name → (body model, shape, motion, posed vertices (T, N_b, 3))`` of a
+    synthetic cache's sequence, re-posed from its plan and checked against the stored
+    body samples (``None`` where that cannot be done, with a warning where it was
+    tried), and the cache's feature-subset size ``N_b'``."""
     from data_prep.config import DataConfig
     from data_prep.plan import plan_dataset, planned_motion
     from gnngarment.config import ConfigError, merge_config
@@ -38,18 +74,22 @@ def synthetic_body_meshes(root: str | Path) -> Callable[[str], BodyMesh | None]:
 
     root = Path(root)
     manifest = read_manifest(root)
+
+    def nothing(name: str) -> None:
+        return None
+
     if "config" not in manifest:
-        return lambda name: None
+        return nothing, 0
     try:
         config = merge_config(DataConfig, manifest["config"], source=f"{root}/manifest.json")
         plans = {plan.name: plan for plan in plan_dataset(config)}
     except (ConfigError, ValueError, KeyError) as error:
         warnings.warn(f"{root}: cannot re-plan the build ({error}); collisions are not "
-                      "resolved", stacklevel=2)
-        return lambda name: None
+                      "resolved", stacklevel=3)
+        return nothing, 0
     state: dict = {}
 
-    def body_mesh(name: str) -> BodyMesh | None:
+    def reposed(name: str):
         import torch
 
         from gnngarment.body.anny_model import AnnyBodyModel, AnnyShape
@@ -71,9 +111,9 @@ def synthetic_body_meshes(root: str | Path) -> Callable[[str], BodyMesh | None]:
             warnings.warn(f"{root}: {name}: the re-posed body does not match the cached "
                           "body samples; its collisions are not resolved", stacklevel=2)
             return None
-        return vertices, model.faces
+        return model, shape, motion, vertices
 
-    return body_mesh
+    return reposed, config.body_vertices
 
 
 def synthetic_skinning_weights(root: str | Path) -> np.ndarray | None:

@@ -412,7 +412,9 @@ def evaluate(
 ) -> None:
     """Report E_verts, E_norm, collision rate, Hausdorff, STED and the spurious-correlation
     test per garment type, for the model and the body-skinning baseline: of the output
-    after collision resolution as animate gives it, and raw_* of the output before it."""
+    after collision resolution as animate gives it, and raw_* of the output before it;
+    and, for a cache built with layered outfits, per garment E_verts and inter-garment
+    penetration of each outfit."""
     import json as json_module
 
     from gnngarment.data import CacheError, PreparedDataset
@@ -433,15 +435,23 @@ def evaluate(
         raise fail(str(error)) from None
     from tqdm import tqdm
 
-    from data_prep.posed_bodies import synthetic_body_meshes, synthetic_skinning_weights
+    from data_prep.posed_bodies import (
+        synthetic_body_inputs,
+        synthetic_body_meshes,
+        synthetic_skinning_weights,
+    )
+    from gnngarment.evaluation.outfits import outfit_names
 
-    bar = tqdm(total=len(dataset), desc=f"evaluating {split}", unit="sequence")
+    # Sequences, then the split's layered outfits (a cache built with `outfits`).
+    bar = tqdm(total=len(dataset) + len(outfit_names(dataset)), desc=f"evaluating {split}",
+               unit="sequence")
     try:  # a cache file is hash-checked when first read: a swapped one fails here
         report = run_evaluation({"ours": model}, dataset, spurious=spurious,
                                 progress=lambda name: bar.update(1),
                                 body_meshes=synthetic_body_meshes(data),
                                 collisions=_collision_settings(),
-                                body_skinning_weights=synthetic_skinning_weights(data))
+                                body_skinning_weights=synthetic_skinning_weights(data),
+                                outfit_body_inputs=synthetic_body_inputs(data))
     except CacheError as error:
         raise fail(str(error)) from None
     bar.close()

@@ -7,6 +7,7 @@ Layout under a cache root (every file written atomically; ``manifest.json`` last
     garments/<garment>.npz        a garment on its rest body: rest_pos, faces, descriptor
     bodies/<body>.npz             rest joints, body-shape feature D, subset indices
     sequences/<sequence>.npz      one simulated (garment, body, motion) sequence
+    outfits/<outfit>.npz          a layered outfit (garments worn together) simulated in one scene
 
 A *garment* here is one garment design fitted to one body (same topology for every
 body, different rest positions), as in CLOTH3D where every sequence has its own fit.
@@ -17,6 +18,7 @@ from __future__ import annotations
 import hashlib
 import json
 from dataclasses import dataclass
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -33,6 +35,7 @@ GARMENT_ARRAYS = ("rest_pos", "faces", "descriptor", "topology", "garment_type",
 BODY_ARRAYS = ("joints", "distances", "subset")
 SEQUENCE_ARRAYS = ("garment", "body", "motion", "fps", "positions", "joint_transforms",
                    "motion_features", "velocities", "body_points", "body_normals")
+OUTFIT_ARRAYS = ("sequence", "garments", "start_pos", "positions", "counts")
 
 
 class CacheError(ValueError):
@@ -119,6 +122,27 @@ class SequenceRecord:
         return int(self.positions.shape[0])
 
 
+@dataclass
+class OutfitRecord:
+    """``outfits/<name>.npz``: garments worn together, simulated in one scene on the body
+    and motion of ``sequence`` (a sequence of the cache: its joint transforms, motion
+    features and velocities are the outfit's).
+
+    Shapes:
+        garments: ``G`` cache garment names, innermost first;
+        start_pos: per garment ``(N_g, 3)`` where the simulation started [m]: the
+            garment's template, moved out of the garments beneath it (they were draped
+            apart);
+        positions: per garment ``(T, N_g, 3)`` ground truth [m].
+    """
+
+    name: str
+    sequence: str
+    garments: list[str]
+    start_pos: list[np.ndarray]
+    positions: list[np.ndarray]
+
+
 def _strings(record, names) -> dict[str, np.ndarray]:
     return {name: np.array(getattr(record, name)) for name in names}
 
@@ -159,6 +183,34 @@ def write_sequence(root: Path, record: SequenceRecord) -> Path:
         "body_points": record.body_points.astype(np.float16),
         "body_normals": record.body_normals.astype(np.float16)})
     return path
+
+
+def write_outfit(root: Path, record: OutfitRecord) -> Path:
+    path = root / "outfits" / f"{record.name}.npz"
+    save_npz_atomic(path, {
+        "sequence": np.array(record.sequence), "garments": np.array(record.garments),
+        "counts": np.array([len(p) for p in record.start_pos], dtype=np.int64),
+        "start_pos": np.concatenate(record.start_pos).astype(np.float32),
+        "positions": np.concatenate(record.positions, axis=1).astype(np.float32)})
+    return path
+
+
+def read_outfit(root: Path, name: str) -> OutfitRecord:
+    path = root / "outfits" / f"{name}.npz"
+    data = load_npz(path, OUTFIT_ARRAYS)
+    counts = data["counts"].astype(np.int64)
+    garments = [str(g) for g in data["garments"]]
+    start, positions = data["start_pos"], data["positions"]
+    if (len(counts) != len(garments) or counts.sum() != len(start)
+            or positions.ndim != 3 or positions.shape[1] != len(start)):
+        raise CacheError(f"{path}: garments, counts, start_pos and positions disagree")
+    if not np.isfinite(positions).all():
+        raise CacheError(f"{path}: positions contain NaN or inf")
+    bounds = np.concatenate([[0], np.cumsum(counts)])
+    return OutfitRecord(name=name, sequence=str(data["sequence"]), garments=garments,
+                        start_pos=[start[a:b] for a, b in pairwise(bounds)],
+                        positions=[positions[:, a:b]
+                                   for a, b in pairwise(bounds)])
 
 
 def read_garment(root: Path, name: str) -> GarmentRecord:
@@ -290,7 +342,8 @@ def write_manifest(root: str | Path, splits: dict[str, list[str]],
                    sequences: dict[str, dict], extra: dict | None = None) -> dict:
     """Write ``manifest.json`` (the commit point of a build) listing every cache file
     with its sha256 (``files``) and byte size (``sizes``), the splits and per-sequence
-    info (garment, body, motion, frames).
+    info (garment, body, motion, frames); ``extra`` keys go in as they are (a build's
+    ``outfits``: per outfit its split, sequence and garments).
 
     Raises:
         CacheError: a split names a sequence without a file.
@@ -301,7 +354,7 @@ def write_manifest(root: str | Path, splits: dict[str, list[str]],
             if not (root / "sequences" / f"{name}.npz").is_file():
                 raise CacheError(f"{root}: split '{split}' lists {name}, which has no file")
     files = {str(path.relative_to(root)): file_hash(path)
-             for folder in ("topologies", "garments", "bodies", "sequences")
+             for folder in ("topologies", "garments", "bodies", "sequences", "outfits")
              for path in sorted((root / folder).glob("*.npz"))}
     digest = hashlib.sha256(json.dumps(files, sort_keys=True).encode()).hexdigest()
     sizes = {relative: (root / relative).stat().st_size for relative in files}

@@ -14,6 +14,7 @@ from gnngarment.body.skinning import skin
 from gnngarment.data.cache import read_body, read_garment
 from gnngarment.data.dataset import PreparedDataset, window_indices
 from gnngarment.evaluation import metrics
+from gnngarment.evaluation.outfits import OUTFIT_METRICS, BodyInputs, evaluate_outfits
 from gnngarment.evaluation.perturbation import (
     DEFAULT_IRRELEVANT_JOINT,
     IRRELEVANT_JOINT,
@@ -46,6 +47,9 @@ class EvaluationReport:
         split: evaluated split; frames: frames evaluated.
         unresolved: sequences evaluated without collision resolution (no posed body
             mesh known for them): there the metrics equal the ``raw_*`` ones.
+        outfits: ``{method: {outfit: {metric: value}}}`` of the split's layered outfits
+            (:mod:`gnngarment.evaluation.outfits`; ``"mean"`` over them), empty for a
+            cache without.
     """
 
     split: str
@@ -53,10 +57,12 @@ class EvaluationReport:
     sequences: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)
     frames: int = 0
     unresolved: list[str] = field(default_factory=list)
+    outfits: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)
 
     def to_json(self) -> str:
         return json.dumps({"split": self.split, "frames": self.frames, "results": self.results,
-                           "sequences": self.sequences, "unresolved": self.unresolved},
+                           "sequences": self.sequences, "unresolved": self.unresolved,
+                           "outfits": self.outfits},
                           indent=2)
 
     def to_markdown(self) -> str:
@@ -85,6 +91,17 @@ class EvaluationReport:
         if self.unresolved:
             lines.append(f"Not resolved (no posed body mesh): {len(self.unresolved)} "
                          "sequence(s), whose metrics equal the raw ones.")
+        for method, outfits in self.outfits.items():
+            lines += ["", f"Layered outfits, {method} (E_verts mm against the simulation of "
+                      "both garments in one scene; through: % of the outer garment's "
+                      "vertices behind the inner one):", "",
+                      "| outfit | inner E_verts | outer E_verts | outer alone | inner body "
+                      "skinning | outer body skinning | through: simulation | raw | "
+                      "resolved | largest push mm |", "|" + "---|" * 10]
+            for name, values in outfits.items():
+                cells = [f"{values[m]:.2f}" for m in OUTFIT_METRICS]
+                lines.append(f"| {'**mean**' if name == 'mean' else name} | "
+                             + " | ".join(cells) + " |")
         return "\n".join(lines)
 
 
@@ -240,7 +257,8 @@ def evaluate(models: dict[str, GarmentDeformer], dataset: PreparedDataset,
              progress: Callable[[str], None] | None = None,
              body_meshes: BodyMeshes | None = None,
              collisions: CollisionSettings | None = None,
-             body_skinning_weights: np.ndarray | None = None) -> EvaluationReport:
+             body_skinning_weights: np.ndarray | None = None,
+             outfit_body_inputs: BodyInputs | None = None) -> EvaluationReport:
     """Metrics of every model in ``models`` (and the body-skinning baseline) on every
     sequence of ``dataset``'s split, after collision resolution as
     :func:`~gnngarment.inference.animate.animate` does it, with the raw output's
@@ -262,6 +280,8 @@ def evaluate(models: dict[str, GarmentDeformer], dataset: PreparedDataset,
             vertex's skinning weight on joints whose body region is more than 20 cm from
             it (:func:`~gnngarment.evaluation.metrics.far_joint_weight`; frame 0 of a
             body mesh is its rest pose).
+        outfit_body_inputs: the body inputs of a sequence as ``animate`` makes them; with
+            it the split's layered outfits are evaluated too (``report.outfits``).
     """
     report = EvaluationReport(split=dataset.split)
     types = {n: dataset.garment_of(n).garment_type for n in dataset.sequence_names}
@@ -298,6 +318,12 @@ def evaluate(models: dict[str, GarmentDeformer], dataset: PreparedDataset,
                 methods["body skinning (draped template)"][name] = values
         if progress is not None:
             progress(name)
+    if outfit_body_inputs is not None:
+        for method, model in models.items():
+            outfits = evaluate_outfits(model, dataset, outfit_body_inputs, collisions,
+                                       progress=progress)
+            if outfits:
+                report.outfits[method] = outfits
     for method, per_sequence in methods.items():
         if per_sequence:
             report.sequences[method] = per_sequence

@@ -49,3 +49,36 @@ def test_training_motions_move_every_joint(config_name: str) -> None:
     still = {name: round(float(deg), 1) for name, deg in zip(JOINT_NAMES, largest, strict=True)
              if deg < 15.0}
     assert not still, f"joints that turn less than 15° in {config_name}'s training motions: {still}"
+
+
+def test_outfits_pair_a_test_bottom_and_top_on_one_body_and_the_bottoms_motions() -> None:
+    """Each planned outfit wears a test top over a test bottom draped on the same test
+    body, on a held-out motion of one of the bottom's own test sequences; the plan is
+    deterministic, capped by ``outfits``, and empty with ``outfits: 0``."""
+    from dataclasses import replace
+
+    from data_prep.plan import BOTTOM_TYPES, TOP_TYPES, plan_outfits
+
+    config = load_config(REPOSITORY_ROOT / "configs" / "data" / "benchmark_cmu.yaml", DataConfig)
+    assert plan_outfits(replace(config, outfits=0)) == []
+    config = replace(config, outfits=3)
+    plans = plan_dataset(config)
+    outfits = plan_outfits(config, plans)
+    assert outfits == plan_outfits(config)
+    tests = {p.name: p for p in plans if p.split == "test"}
+    pairs = {(o.sequence.design.name, o.top.name) for o in outfits}
+    assert len(pairs) == 3
+    for outfit in outfits:
+        assert outfit.sequence.name in tests
+        assert outfit.sequence.design.garment_type in BOTTOM_TYPES
+        assert outfit.top.garment_type in TOP_TYPES and outfit.top.split == "test"
+        # The top is draped on the same body (one of its own test sequences uses it).
+        assert any(p.design == outfit.top and p.body.name == outfit.sequence.body.name
+                   for p in tests.values())
+    # Every held-out motion of a chosen bottom's sequences on that body is an outfit.
+    for bottom, top in pairs:
+        body = next(o.sequence.body.name for o in outfits if o.top.name == top)
+        motions = {p.motion.name for p in tests.values()
+                   if p.design.name == bottom and p.body.name == body}
+        assert {o.sequence.motion.name for o in outfits
+                if o.top.name == top and o.sequence.design.name == bottom} == motions
