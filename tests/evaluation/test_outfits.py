@@ -46,9 +46,9 @@ def cache(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def test_outfit_is_simulated_from_a_layered_start_and_resumed(cache: Path) -> None:
-    """The outfit holds both garments on its bottom's sequence: as many frames, the top
-    started outside the bottom (the drapes were made apart) and the bottom where its
-    template is; a second build simulates nothing again."""
+    """The outfit holds both garments on its bottom's sequence: as many frames, starting
+    where the top was moved outside the bottom (the drapes, made apart, overlap) and the
+    bottom at its template; a second build simulates nothing again."""
     manifest = json.loads((cache / "manifest.json").read_text())
     (name, info), = manifest["outfits"].items()
     assert info["split"] == "test" and f"outfits/{name}.npz" in manifest["files"]
@@ -58,6 +58,8 @@ def test_outfit_is_simulated_from_a_layered_start_and_resumed(cache: Path) -> No
     sequence = read_sequence(cache, record.sequence)
     for positions, garment in zip(record.positions, (bottom, top), strict=True):
         assert positions.shape == (sequence.num_frames, len(garment.rest_pos), 3)
+    for positions, start in zip(record.positions, record.start_pos, strict=True):
+        np.testing.assert_allclose(positions[0], start, atol=1e-5)  # frame 0: the start
     np.testing.assert_allclose(record.start_pos[0], bottom.rest_pos, atol=1e-6)
     from data_prep.bodies import anny_body_model, anny_shape
     from data_prep.plan import plan_dataset
@@ -66,7 +68,7 @@ def test_outfit_is_simulated_from_a_layered_start_and_resumed(cache: Path) -> No
     body = anny_body_model().rest(anny_shape(plan.body))
     faces = outward_faces(record.start_pos[0], bottom.faces, body.vertices.numpy(),
                           body.faces)
-    # The drapes, made apart, overlap; the start the simulation got does not.
+    # The drapes, made apart, overlap; the outfit's start does not.
     assert layer_penetration(top.rest_pos[None], record.start_pos[0][None], faces,
                              LayerSettings()).max() > 0.0
     assert layer_penetration(record.start_pos[1][None], record.start_pos[0][None], faces,
