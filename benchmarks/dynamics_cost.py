@@ -16,8 +16,6 @@ parameters are computed once per garment (with the context), and timed apart.
 from __future__ import annotations
 
 import argparse
-import platform
-import subprocess
 import sys
 import time
 from dataclasses import replace
@@ -32,20 +30,11 @@ for path in (ROOT, ROOT / "benchmarks"):
 
 from inference_speed import frame_inputs, make_pair  # noqa: E402
 
+from benchmarks.machine import cpu_model  # noqa: E402
 from data_prep.garments.skirt import flared_skirt  # noqa: E402
 from gnngarment.model import GarmentDeformer  # noqa: E402
 from gnngarment.model.checkpoint import load_model  # noqa: E402
 from gnngarment.paths import SHIPPED_MODEL  # noqa: E402
-
-
-def cpu_model() -> str:
-    try:
-        for line in subprocess.run(["lscpu"], capture_output=True, text=True).stdout.splitlines():
-            if line.startswith("Model name:"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown CPU"
 
 
 def main() -> None:

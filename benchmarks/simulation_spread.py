@@ -34,7 +34,6 @@ import argparse
 import io
 import math
 import os
-import platform
 import sys
 import time
 from pathlib import Path
@@ -46,6 +45,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from benchmarks.machine import cpu_model  # noqa: E402
 from data_prep.bodies import anny_body_model, anny_shape  # noqa: E402
 from data_prep.config import DataConfig  # noqa: E402
 from data_prep.drape_worker import drape_and_prepare_garment  # noqa: E402
@@ -64,17 +64,6 @@ from gnngarment.inference.animate import animate  # noqa: E402
 from gnngarment.io.atomic import atomic_write_bytes  # noqa: E402
 from gnngarment.model.checkpoint import load_model  # noqa: E402
 from gnngarment.paths import SHIPPED_MODEL  # noqa: E402
-
-
-def cpu_model() -> str:
-    """The CPU's model name, as ``lscpu`` prints it."""
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or platform.machine()
 
 
 def chosen_plans(config: DataConfig, per_type: int, motions: str) -> list[SequencePlan]:
