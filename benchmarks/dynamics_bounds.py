@@ -24,7 +24,9 @@ the impulse responses of damped oscillators at 0.5, 1, 2 and 4 Hz with damping r
 0.15 and 0.6, plus the instantaneous value. A sum of fixed-pole second-order filters
 with per-vertex gains is exactly the class of a modal dynamics module. ``--coupling
 diagonal`` lets each offset axis see only the same axis of the inputs (what a per-axis
-oscillator can express); ``full`` lets every axis see every input axis. Ridge ``λ``
+oscillator can express); ``full`` lets every axis see every input axis; ``pose``
+regresses on the vertex's joints' rotations instead (:func:`pose_features`, SMPL's pose
+blend shape class) and ``diagonal+pose`` on both. Ridge ``λ``
 (``--ridge``, on inputs scaled to unit variance) keeps the self-fit from memorising.
 
     .venv/bin/python benchmarks/dynamics_bounds.py [--data data/benchmark_cmu]
@@ -99,23 +101,22 @@ def angular_velocity(frames: np.ndarray, fps: float) -> np.ndarray:
 
 
 class Sequence:
-    """What the fits need of one simulated sequence (float64, metres)."""
+    """What the fits need of one simulated sequence (float64, metres): the rest template
+    ``(N, 3)``, its body weights ``(N, J)``, the joint transforms ``(T, J, 4, 4)`` and the
+    simulated answer ``(T, N, 3)`` at ``fps``."""
 
-    def __init__(self, dataset: PreparedDataset, name: str):
+    def __init__(self, name: str, garment_type: str, motion: str, rest: np.ndarray,
+                 prior: np.ndarray, transforms: np.ndarray, target: np.ndarray, fps: float):
         import torch
 
         from gnngarment.model.oscillator import oscillator_drive
 
-        garment = dataset.garment_of(name)
-        sequence = dataset.sequence(name)
-        self.name, self.type = name, garment.garment_type
-        self.motion = dataset.manifest["sequences"][name]["motion"]
-        self.rest = garment.pair.rest_pos.numpy().astype(np.float64)
-        self.prior = garment.pair.body_weights.numpy().astype(np.float64)
-        self.transforms = sequence.joint_transforms.astype(np.float64)
+        self.name, self.type, self.motion = name, garment_type, motion
+        self.rest = rest.astype(np.float64)
+        self.prior = prior.astype(np.float64)
+        self.transforms = transforms.astype(np.float64)
         self.per_joint = joint_positions(self.rest, self.transforms)
-        self.target = sequence.positions.astype(np.float64)
-        fps = float(dataset.manifest["sequences"][name].get("fps", sequence.fps))
+        self.target = target.astype(np.float64)
         with torch.no_grad():
             drive = oscillator_drive(torch.as_tensor(self.rest), torch.as_tensor(self.prior),
                                      torch.as_tensor(self.transforms), fps).numpy()
@@ -123,6 +124,15 @@ class Sequence:
         bank = filter_bank(len(self.target), fps)
         # (T, N, 6 inputs, K filters): the regressors of every vertex and frame.
         self.inputs = causal_filter(np.concatenate([drive, omega], axis=-1), bank)
+
+    @classmethod
+    def from_dataset(cls, dataset: PreparedDataset, name: str) -> Sequence:
+        garment = dataset.garment_of(name)
+        sequence = dataset.sequence(name)
+        info = dataset.manifest["sequences"][name]
+        return cls(name, garment.garment_type, info["motion"], garment.pair.rest_pos.numpy(),
+                   garment.pair.body_weights.numpy(), sequence.joint_transforms,
+                   sequence.positions, float(info.get("fps", sequence.fps)))
 
     def skinned(self, weights: np.ndarray) -> np.ndarray:
         return blend(self.per_joint, weights)
@@ -134,22 +144,45 @@ class Sequence:
         return np.linalg.solve(frames, residual[..., None])[..., 0]
 
 
-def _design(inputs: np.ndarray, axis: int | None) -> np.ndarray:
-    """Per-vertex regressors ``(N, T, P)``: all six inputs × filters (``axis`` None), or
-    for the diagonal fit the drive's and angular velocity's same axis only."""
-    if axis is not None:
-        inputs = inputs[:, :, [axis, 3 + axis]]
-    return np.transpose(inputs.reshape(*inputs.shape[:2], -1), (1, 0, 2))
+#: How many of a vertex's most-weighted joints the ``pose`` regressors read.
+POSE_JOINTS = 3
+
+
+def pose_features(transforms: np.ndarray, prior: np.ndarray) -> np.ndarray:
+    """``(T, N, 9 POSE_JOINTS)`` the quasi-static regressors of every vertex: ``R − I`` of
+    the rotation of each of its :data:`POSE_JOINTS` most-weighted joints relative to that
+    joint's parent (the root's global rotation is not a pose: zero), the linear-in-``R``
+    class of SMPL's pose blend shapes."""
+    from gnngarment.body.skeleton import JOINT_PARENTS
+
+    rotation = transforms[..., :3, :3]
+    parents = np.array([max(p, 0) for p in JOINT_PARENTS])
+    local = np.swapaxes(rotation[:, parents], -1, -2) @ rotation - np.eye(3)
+    local[:, 0] = 0.0
+    top = np.argsort(-prior, axis=1)[:, :POSE_JOINTS]                       # (N, K)
+    return local[:, top].reshape(len(transforms), len(prior), -1)
+
+
+def _design(sequence: Sequence, axis: int, coupling: str) -> np.ndarray:
+    """Per-vertex regressors ``(N, T, P)`` of output ``axis``: ``full``, all six inputs ×
+    filters; ``diagonal``, the drive's and angular velocity's same axis only; ``pose``,
+    :func:`pose_features`; ``diagonal+pose``, both."""
+    parts = []
+    if coupling in ("full", "diagonal", "diagonal+pose"):
+        inputs = sequence.inputs if coupling == "full" else sequence.inputs[:, :, [axis, 3 + axis]]
+        parts.append(inputs.reshape(*inputs.shape[:2], -1))
+    if coupling.endswith("pose"):
+        parts.append(pose_features(sequence.transforms, sequence.prior))
+    return np.transpose(np.concatenate(parts, axis=-1), (1, 0, 2))
 
 
 def fit_response(train: list[Sequence], weights: list[np.ndarray], coupling: str,
                  ridge: float) -> list[np.ndarray]:
-    """Per-vertex ridge regression of the local residual on the filtered inputs: one
-    coefficient array per output axis, ``(N, P)``."""
+    """Per-vertex ridge regression of the local residual on the regressors of
+    ``coupling`` (:func:`_design`): one coefficient array per output axis, ``(N, P)``."""
     coefficients = []
     for axis in range(3):
-        x = np.concatenate([_design(s.inputs, axis if coupling == "diagonal" else None)
-                            for s in train], axis=1)                          # (N, ΣT, P)
+        x = np.concatenate([_design(s, axis, coupling) for s in train], axis=1)  # (N, ΣT, P)
         y = np.concatenate([s.local_residual(w)[..., axis].T for s, w in zip(train, weights,
                                                                               strict=True)],
                            axis=1)                                            # (N, ΣT)
@@ -164,8 +197,7 @@ def fit_response(train: list[Sequence], weights: list[np.ndarray], coupling: str
 def with_response(sequence: Sequence, weights: np.ndarray, coefficients: list[np.ndarray],
                   coupling: str) -> np.ndarray:
     """``(T, N, 3)`` the garment skinned with ``weights`` plus the fitted response."""
-    offsets = np.stack([np.einsum("ntp,np->tn", _design(sequence.inputs, axis if coupling ==
-                                                        "diagonal" else None), c)
+    offsets = np.stack([np.einsum("ntp,np->tn", _design(sequence, axis, coupling), c)
                         for axis, c in enumerate(coefficients)], axis=-1)
     carried = np.einsum("tnab,tnb->tna", blended_frames(sequence.transforms, weights), offsets)
     return sequence.skinned(weights) + carried
@@ -217,7 +249,7 @@ def main() -> None:
     parser.add_argument("--data", type=Path, default=ROOT / "data" / "benchmark_cmu")
     parser.add_argument("--split", default="test")
     parser.add_argument("--coupling", nargs="+", default=["diagonal", "full"],
-                        choices=["diagonal", "full"])
+                        choices=["diagonal", "full", "pose", "diagonal+pose"])
     parser.add_argument("--ridge", type=float, default=1.0)
     parser.add_argument("--pairs", type=int, default=0, help="at most this many pairs (0: all)")
     args = parser.parse_args()
@@ -235,8 +267,8 @@ def main() -> None:
         pairs = pairs[:args.pairs]
     rows = []
     for names in pairs:
-        rows += evaluate_pair([Sequence(dataset, name) for name in names], args.coupling,
-                              args.ridge)
+        rows += evaluate_pair([Sequence.from_dataset(dataset, name) for name in names],
+                              args.coupling, args.ridge)
     columns = ["body skinning", "weights (self)"]
     columns += [f"+ LTI {c} (self)" for c in args.coupling] + ["weights (other)"]
     columns += [f"+ LTI {c} (other)" for c in args.coupling]

@@ -95,11 +95,12 @@ def rms_distance(a: np.ndarray, b: np.ndarray) -> float:
     return float(1000 * np.sqrt((np.linalg.norm(a - b, axis=-1) ** 2).mean()))
 
 
-def simulate_twice(work: Path, plan: SequencePlan, config: DataConfig, jitter: float,
-                   repeat: bool) -> dict[str, np.ndarray] | str:
-    """The unperturbed and the perturbed simulation of ``plan`` (and a repeat of the
-    unperturbed one when ``repeat``), with the body's joint transforms; or why the
-    simulator left it out."""
+def simulate_starts(work: Path, plan: SequencePlan, config: DataConfig,
+                    starts: dict[str, np.ndarray | None]) -> dict[str, np.ndarray] | str:
+    """Newton simulations of ``plan`` from each of ``starts`` (``(N, 3)`` metres; None:
+    the draped template in ``work``, as the builder starts), with the body's joint
+    transforms under ``"joint_transforms"`` and each run's substeps; or why the simulator
+    left one out."""
     body_model = anny_body_model()
     shape = anny_shape(plan.body)
     motion = planned_motion(plan.motion, config, body_model, shape)
@@ -112,17 +113,11 @@ def simulate_twice(work: Path, plan: SequencePlan, config: DataConfig, jitter: f
     settings = load_simulation_settings(config.simulation)
     if config.settle_frames >= 0:
         settings.settle_frames = config.settle_frames
-    free = np.ones(len(garment.rest_pos), bool)
-    free[pinned] = False
-    noise = np.random.default_rng(0).normal(0.0, jitter, garment.rest_pos.shape)
-    perturbed = garment.rest_pos + noise * free[:, None]
     runs: dict[str, np.ndarray] = {"joint_transforms": transforms}
-    starts = {"answer": garment.rest_pos, "perturbed": perturbed}
-    if repeat:
-        starts["repeat"] = garment.rest_pos
     for key, start in starts.items():
         try:
-            result = simulate_garment(start, garment.faces, posed.vertices.numpy(),
+            result = simulate_garment(garment.rest_pos if start is None else start,
+                                      garment.faces, posed.vertices.numpy(),
                                       body_model.faces, config.fps, fabric=plan.design.fabric,
                                       pinned=pinned if len(pinned) else None,
                                       pin_targets=targets, settings=settings)
@@ -131,6 +126,23 @@ def simulate_twice(work: Path, plan: SequencePlan, config: DataConfig, jitter: f
         runs[key] = result.positions
         runs[f"{key}_substeps"] = np.array(result.substeps)
     return runs
+
+
+def simulate_twice(work: Path, plan: SequencePlan, config: DataConfig, jitter: float,
+                   repeat: bool) -> dict[str, np.ndarray] | str:
+    """The unperturbed and the perturbed simulation of ``plan`` (and a repeat of the
+    unperturbed one when ``repeat``), with the body's joint transforms; or why the
+    simulator left it out."""
+    garment = read_garment(work, plan.garment)
+    pinned, _ = read_pins(work, plan.garment)
+    free = np.ones(len(garment.rest_pos), bool)
+    free[pinned] = False
+    noise = np.random.default_rng(0).normal(0.0, jitter, garment.rest_pos.shape)
+    starts: dict[str, np.ndarray | None] = {
+        "answer": None, "perturbed": garment.rest_pos + noise * free[:, None]}
+    if repeat:
+        starts["repeat"] = None
+    return simulate_starts(work, plan, config, starts)
 
 
 def main() -> None:
