@@ -20,6 +20,11 @@ E_verts mm, on every test window:
 * ``+ pose``: plus a linear response to the rotations of the vertex's three
   most-weighted joints relative to their parents (SMPL's pose blend shape class);
 * ``+ LTI + pose``: both;
+* ``nearest state``: plus, per frame, the mean local residual of the ``--neighbours``
+  training frames whose body state is nearest (the rotations, relative to their parents,
+  of the joints that carry the garment, now and 3 and 6 frames before: pose, velocity
+  and acceleration) — a non-parametric regressor, *nonlinear* in the motion, that can
+  win only where a state seen in training recurs;
 
 each at the ridge (of ``--ridges``) that scores best on the test windows: an optimistic
 choice, as befits a bound. For reference: body skinning of the draped template, weights
@@ -31,6 +36,7 @@ model of that class reach further; a flat one says the class is the limit.
         [--config configs/data/benchmark_cmu.yaml] [--work runs/simulation_spread]
         [--train-windows 16] [--test-windows 6] [--counts 1 2 4 8 16] [--draws 3]
         [--ridges 1 100 10000] [--workers 2] [--types dress skirt ...]
+        [--responses diagonal pose diagonal+pose nearest] [--neighbours 5]
 
 Simulations (~20 s each on one core) are saved under ``--work``/motion_count, so an
 interrupted run resumes; ``--workers`` run them in parallel processes of one thread.
@@ -55,7 +61,12 @@ for path in (ROOT, ROOT / "benchmarks"):
     if str(path) not in sys.path:
         sys.path.insert(0, str(path))
 
-from dynamics_bounds import Sequence, fit_response, with_response  # noqa: E402
+from dynamics_bounds import (  # noqa: E402
+    Sequence,
+    blended_frames,
+    fit_response,
+    with_response,
+)
 from simulation_spread import chosen_plans, simulate_starts  # noqa: E402
 from skinning_bounds import fit_weights, vertex_error_mm  # noqa: E402
 
@@ -68,8 +79,44 @@ from gnngarment.data.cache import read_garment  # noqa: E402
 from gnngarment.io.atomic import atomic_write_bytes  # noqa: E402
 
 #: The per-garment model classes fitted on the training windows, in table order.
-RESPONSES = ("diagonal", "pose", "diagonal+pose")
-RESPONSE_NAMES = {"diagonal": "+ LTI", "pose": "+ pose", "diagonal+pose": "+ LTI + pose"}
+RESPONSES = ("diagonal", "pose", "diagonal+pose", "nearest")
+RESPONSE_NAMES = {"diagonal": "+ LTI", "pose": "+ pose", "diagonal+pose": "+ LTI + pose",
+                  "nearest": "nearest state"}
+#: The frames before the current one whose pose the nearest-state regressor also reads.
+STATE_LAGS = (0, 3, 6)
+#: A joint carries the garment when some vertex's body weight on it exceeds this.
+CARRYING_WEIGHT = 0.05
+
+
+def body_state(sequence: Sequence) -> np.ndarray:
+    """``(T, D)`` the body state the nearest-state regressor compares: ``R − I`` of the
+    rotations (relative to the parent) of the joints that carry the garment, at each of
+    :data:`STATE_LAGS` frames back (the first frame repeated before the start)."""
+    from gnngarment.body.skeleton import JOINT_PARENTS
+
+    rotation = sequence.transforms[..., :3, :3]
+    parents = np.array([max(p, 0) for p in JOINT_PARENTS])
+    local = np.swapaxes(rotation[:, parents], -1, -2) @ rotation - np.eye(3)
+    carrying = np.flatnonzero(sequence.prior.max(axis=0) > CARRYING_WEIGHT)
+    carrying = carrying[carrying != 0]  # the root's global rotation is not a pose
+    pose = local[:, carrying].reshape(len(rotation), -1)
+    frames = np.arange(len(pose))
+    return np.concatenate([pose[np.maximum(frames - lag, 0)] for lag in STATE_LAGS], axis=1)
+
+
+def nearest_state(train: list[Sequence], weights: np.ndarray, sequence: Sequence,
+                  neighbours: int) -> np.ndarray:
+    """``(T, N, 3)`` ``sequence`` skinned with ``weights`` plus, per frame, the mean local
+    residual of the ``neighbours`` training frames of the nearest body state."""
+    states = np.concatenate([body_state(s) for s in train])
+    residuals = np.concatenate([s.local_residual(weights) for s in train])       # (ΣT, N, 3)
+    scale = states.std(axis=0) + 1e-6
+    query = body_state(sequence) / scale
+    distance = ((query[:, None, :] - (states / scale)[None]) ** 2).sum(-1)         # (T, ΣT)
+    nearest = np.argsort(distance, axis=1)[:, :neighbours]
+    offsets = residuals[nearest].mean(axis=1)                                      # (T, N, 3)
+    carried = np.einsum("tnab,tnb->tna", blended_frames(sequence.transforms, weights), offsets)
+    return sequence.skinned(weights) + carried
 
 
 def chosen_windows(config: DataConfig, train: int, test: int) -> tuple[list[MotionPlan],
@@ -154,7 +201,8 @@ def shipped_model_error(work: Path, plan: SequencePlan, config: DataConfig,
 
 
 def garment_curve(train: list[Sequence], test: list[Sequence], counts: list[int],
-                  draws: int, ridges: list[float], seed: int) -> list[dict]:
+                  draws: int, ridges: list[float], seed: int, responses: list[str],
+                  neighbours: int) -> list[dict]:
     """One row per (count, draw): mean E_verts (mm) over ``test`` of each fitted class."""
     rng = np.random.default_rng(seed)
     rows = []
@@ -169,7 +217,11 @@ def garment_curve(train: list[Sequence], test: list[Sequence], counts: list[int]
                                   chosen[0].prior)
             row = {"count": count, "weights": float(np.mean(
                 [vertex_error_mm(s.skinned(weights), s.target) for s in test]))}
-            for response in RESPONSES:
+            for response in responses:
+                if response == "nearest":
+                    row[response] = float(np.mean([vertex_error_mm(nearest_state(
+                        chosen, weights, s, neighbours), s.target) for s in test]))
+                    continue
                 best = np.inf
                 for ridge in ridges:
                     fitted = fit_response(chosen, [weights] * len(chosen), response, ridge)
@@ -199,6 +251,10 @@ def main() -> None:
     parser.add_argument("--types", nargs="+", default=None, help="garment types (default all)")
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--no-model", action="store_true", help="skip the shipped model's row")
+    parser.add_argument("--responses", nargs="+", default=list(RESPONSES), choices=RESPONSES,
+                        help="the fitted classes beyond the weights")
+    parser.add_argument("--neighbours", type=int, default=5,
+                        help="training frames the nearest-state regressor averages")
     args = parser.parse_args()
     torch.set_num_threads(1)
     config = load_config(args.config, DataConfig)
@@ -246,14 +302,15 @@ def main() -> None:
         if not args.no_model:
             reference["shipped model"] = float(np.mean(
                 [shipped_model_error(args.work, p, config, s.target) for p, s in test]))
-        rows = garment_curve(train, tests, args.counts, args.draws, args.ridges, seed=0)
+        rows = garment_curve(train, tests, args.counts, args.draws, args.ridges, seed=0,
+                             responses=args.responses, neighbours=args.neighbours)
         summary.append((garment, group[0].design.garment_type, len(train), len(tests),
                         reference, rows))
 
     print("\nE_verts mm on the test-subject windows (ratio to body skinning of the draped "
           "template); fitted classes: mean over draws, best ridge of "
           + ", ".join(f"{r:g}" for r in args.ridges))
-    columns = ["weights", *RESPONSES]
+    columns = ["weights", *args.responses]
     print("| garment | train / test windows | body skinning | weights (self) | shipped model | k "
           "| " + " | ".join("weights" if c == "weights" else RESPONSE_NAMES[c]
                             for c in columns) + " |")
