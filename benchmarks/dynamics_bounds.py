@@ -148,19 +148,25 @@ class Sequence:
 POSE_JOINTS = 3
 
 
-def pose_features(transforms: np.ndarray, prior: np.ndarray) -> np.ndarray:
-    """``(T, N, 9 POSE_JOINTS)`` the quasi-static regressors of every vertex: ``R − I`` of
-    the rotation of each of its :data:`POSE_JOINTS` most-weighted joints relative to that
-    joint's parent (the root's global rotation is not a pose: zero), the linear-in-``R``
-    class of SMPL's pose blend shapes."""
+def local_rotations(transforms: np.ndarray) -> np.ndarray:
+    """``(T, J, 3, 3)`` ``R − I`` of every joint's rotation relative to its parent, from
+    ``(T, J, 4, 4)`` skinning transforms; zero for the root (its global rotation is not a
+    pose)."""
     from gnngarment.body.skeleton import JOINT_PARENTS
 
     rotation = transforms[..., :3, :3]
     parents = np.array([max(p, 0) for p in JOINT_PARENTS])
     local = np.swapaxes(rotation[:, parents], -1, -2) @ rotation - np.eye(3)
     local[:, 0] = 0.0
+    return local
+
+
+def pose_features(transforms: np.ndarray, prior: np.ndarray) -> np.ndarray:
+    """``(T, N, 9 POSE_JOINTS)`` the quasi-static regressors of every vertex: the
+    :func:`local_rotations` of its :data:`POSE_JOINTS` most-weighted joints, the
+    linear-in-``R`` class of SMPL's pose blend shapes."""
     top = np.argsort(-prior, axis=1)[:, :POSE_JOINTS]                       # (N, K)
-    return local[:, top].reshape(len(transforms), len(prior), -1)
+    return local_rotations(transforms)[:, top].reshape(len(transforms), len(prior), -1)
 
 
 def _design(sequence: Sequence, axis: int, coupling: str) -> np.ndarray:

@@ -65,6 +65,7 @@ from dynamics_bounds import (  # noqa: E402
     Sequence,
     blended_frames,
     fit_response,
+    local_rotations,
     with_response,
 )
 from simulation_spread import chosen_plans, simulate_starts  # noqa: E402
@@ -92,31 +93,35 @@ def body_state(sequence: Sequence) -> np.ndarray:
     """``(T, D)`` the body state the nearest-state regressor compares: ``R − I`` of the
     rotations (relative to the parent) of the joints that carry the garment, at each of
     :data:`STATE_LAGS` frames back (the first frame repeated before the start)."""
-    from gnngarment.body.skeleton import JOINT_PARENTS
-
-    rotation = sequence.transforms[..., :3, :3]
-    parents = np.array([max(p, 0) for p in JOINT_PARENTS])
-    local = np.swapaxes(rotation[:, parents], -1, -2) @ rotation - np.eye(3)
     carrying = np.flatnonzero(sequence.prior.max(axis=0) > CARRYING_WEIGHT)
     carrying = carrying[carrying != 0]  # the root's global rotation is not a pose
-    pose = local[:, carrying].reshape(len(rotation), -1)
+    pose = local_rotations(sequence.transforms)[:, carrying].reshape(len(sequence.target), -1)
     frames = np.arange(len(pose))
     return np.concatenate([pose[np.maximum(frames - lag, 0)] for lag in STATE_LAGS], axis=1)
 
 
-def nearest_state(train: list[Sequence], weights: np.ndarray, sequence: Sequence,
-                  neighbours: int) -> np.ndarray:
-    """``(T, N, 3)`` ``sequence`` skinned with ``weights`` plus, per frame, the mean local
-    residual of the ``neighbours`` training frames of the nearest body state."""
-    states = np.concatenate([body_state(s) for s in train])
-    residuals = np.concatenate([s.local_residual(weights) for s in train])       # (ΣT, N, 3)
-    scale = states.std(axis=0) + 1e-6
-    query = body_state(sequence) / scale
-    distance = ((query[:, None, :] - (states / scale)[None]) ** 2).sum(-1)         # (T, ΣT)
-    nearest = np.argsort(distance, axis=1)[:, :neighbours]
-    offsets = residuals[nearest].mean(axis=1)                                      # (T, N, 3)
-    carried = np.einsum("tnab,tnb->tna", blended_frames(sequence.transforms, weights), offsets)
-    return sequence.skinned(weights) + carried
+class NearestState:
+    """The nearest-state regressor fitted to ``train`` under ``weights``: the training
+    frames' body states (:func:`body_state`, scaled to unit spread) and local residuals,
+    computed once for every test sequence it predicts."""
+
+    def __init__(self, train: list[Sequence], weights: np.ndarray, neighbours: int):
+        states = np.concatenate([body_state(s) for s in train])
+        self.scale = states.std(axis=0) + 1e-6
+        self.states = states / self.scale
+        self.residuals = np.concatenate([s.local_residual(weights) for s in train])  # (ΣT, N, 3)
+        self.weights, self.neighbours = weights, neighbours
+
+    def predict(self, sequence: Sequence) -> np.ndarray:
+        """``(T, N, 3)`` ``sequence`` skinned with the weights plus, per frame, the mean
+        local residual of the ``neighbours`` training frames of the nearest body state."""
+        query = body_state(sequence) / self.scale
+        distance = ((query[:, None, :] - self.states[None]) ** 2).sum(-1)          # (T, ΣT)
+        nearest = np.argsort(distance, axis=1)[:, :self.neighbours]
+        offsets = self.residuals[nearest].mean(axis=1)                              # (T, N, 3)
+        carried = np.einsum("tnab,tnb->tna", blended_frames(sequence.transforms, self.weights),
+                            offsets)
+        return sequence.skinned(self.weights) + carried
 
 
 def chosen_windows(config: DataConfig, train: int, test: int) -> tuple[list[MotionPlan],
@@ -160,12 +165,15 @@ def simulate_all(work: Path, plans: list[SequencePlan], config: DataConfig,
     print(f"{len(plans) - len(todo)} of {len(plans)} sequences already simulated; "
           f"{len(todo)} to go on {workers} worker(s)", file=sys.stderr, flush=True)
     tasks = [(str(work), p, config) for p in todo]
+    def report(results) -> None:
+        for done, (name, status) in enumerate(results, 1):
+            print(f"  [{done}/{len(todo)}] {name}: {status}", file=sys.stderr, flush=True)
+
     if workers <= 1:
-        results = map(_simulate, tasks)
-    else:
-        results = get_context("spawn").Pool(workers).imap_unordered(_simulate, tasks)
-    for done, (name, status) in enumerate(results, 1):
-        print(f"  [{done}/{len(todo)}] {name}: {status}", file=sys.stderr, flush=True)
+        report(map(_simulate, tasks))
+        return
+    with get_context("spawn").Pool(workers) as pool:
+        report(pool.imap_unordered(_simulate, tasks))
 
 
 def load_sequence(work: Path, plan: SequencePlan, config: DataConfig) -> Sequence | None:
@@ -179,9 +187,9 @@ def load_sequence(work: Path, plan: SequencePlan, config: DataConfig) -> Sequenc
                         stored["answer"], config.fps)
 
 
-def shipped_model_error(work: Path, plan: SequencePlan, config: DataConfig,
-                        target: np.ndarray) -> float:
-    """E_verts (mm) of the shipped model as ``animate`` runs it."""
+def shipped_model_errors(work: Path, tests: list[tuple[SequencePlan, Sequence]],
+                         config: DataConfig) -> list[float]:
+    """E_verts (mm) of the shipped model as ``animate`` runs it, per test sequence."""
     from data_prep.bodies import anny_body_model, anny_shape
     from data_prep.plan import planned_motion
     from gnngarment.data.body_inputs import body_motion_inputs, body_shape_inputs
@@ -191,13 +199,16 @@ def shipped_model_error(work: Path, plan: SequencePlan, config: DataConfig,
 
     model = load_model(SHIPPED_MODEL)
     body_model = anny_body_model()
-    shape = anny_shape(plan.body)
-    motion = planned_motion(plan.motion, config, body_model, shape)
-    garment = read_garment(work, plan.garment)
-    body = body_shape_inputs(body_model, shape, model.config.body_vertices)
-    frames = body_motion_inputs(body_model, shape, motion, model.config.body_vertices)
-    posed = np.asarray(animate(model, garment.rest_pos, garment.faces, body, frames).posed)
-    return vertex_error_mm(posed, target)
+    errors = []
+    for plan, sequence in tests:
+        shape = anny_shape(plan.body)
+        motion = planned_motion(plan.motion, config, body_model, shape)
+        garment = read_garment(work, plan.garment)
+        body = body_shape_inputs(body_model, shape, model.config.body_vertices)
+        frames = body_motion_inputs(body_model, shape, motion, model.config.body_vertices)
+        posed = np.asarray(animate(model, garment.rest_pos, garment.faces, body, frames).posed)
+        errors.append(vertex_error_mm(posed, sequence.target))
+    return errors
 
 
 def garment_curve(train: list[Sequence], test: list[Sequence], counts: list[int],
@@ -219,8 +230,9 @@ def garment_curve(train: list[Sequence], test: list[Sequence], counts: list[int]
                 [vertex_error_mm(s.skinned(weights), s.target) for s in test]))}
             for response in responses:
                 if response == "nearest":
-                    row[response] = float(np.mean([vertex_error_mm(nearest_state(
-                        chosen, weights, s, neighbours), s.target) for s in test]))
+                    regressor = NearestState(chosen, weights, neighbours)
+                    row[response] = float(np.mean([vertex_error_mm(regressor.predict(s),
+                                                                   s.target) for s in test]))
                     continue
                 best = np.inf
                 for ridge in ridges:
@@ -300,8 +312,8 @@ def main() -> None:
             "weights (self)": float(np.mean([vertex_error_mm(s.skinned(fit_weights(
                 [s.per_joint], [s.target], s.prior)), s.target) for s in tests]))}
         if not args.no_model:
-            reference["shipped model"] = float(np.mean(
-                [shipped_model_error(args.work, p, config, s.target) for p, s in test]))
+            reference["shipped model"] = float(np.mean(shipped_model_errors(args.work, test,
+                                                                            config)))
         rows = garment_curve(train, tests, args.counts, args.draws, args.ridges, seed=0,
                              responses=args.responses, neighbours=args.neighbours)
         summary.append((garment, group[0].design.garment_type, len(train), len(tests),
