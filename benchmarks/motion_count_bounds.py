@@ -139,6 +139,17 @@ def chosen_windows(config: DataConfig, train: int, test: int) -> tuple[list[Moti
         per_clip += 1
 
 
+def window_plans(config: DataConfig, windows: list[MotionPlan], types: list[str] | None
+                 ) -> tuple[list[SequencePlan], dict[str, list[SequencePlan]]]:
+    """The test designs (one per type of ``types``, all when None, on the first test
+    body) and, per design's garment, its sequence on each of ``windows``."""
+    designs = [p for p in chosen_plans(config, 1, "procedural")
+               if types is None or p.design.garment_type in types]
+    plans = {d.garment: [dataclasses.replace(d, motion=m, name=f"{d.garment}_{m.name}")
+                         for m in windows] for d in designs}
+    return designs, plans
+
+
 def _saved(work: Path, plan: SequencePlan) -> Path:
     return work / "motion_count" / f"{plan.name}.npz"
 
@@ -271,12 +282,9 @@ def main() -> None:
     torch.set_num_threads(1)
     config = load_config(args.config, DataConfig)
     train_windows, test_windows = chosen_windows(config, args.train_windows, args.test_windows)
-    designs = [p for p in chosen_plans(config, 1, "procedural")
-               if args.types is None or p.design.garment_type in args.types]
+    designs, plans = window_plans(config, train_windows + test_windows, args.types)
     if not designs:
         sys.exit(f"error: {args.config}: no test design of types {args.types}")
-    plans = {d.garment: [dataclasses.replace(d, motion=m, name=f"{d.garment}_{m.name}")
-                         for m in train_windows + test_windows] for d in designs}
     print(f"{len(designs)} designs × ({len(train_windows)} training-subject + "
           f"{len(test_windows)} test-subject CMU windows) of {args.config.name}; "
           f"{cpu_model()}, load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores",
