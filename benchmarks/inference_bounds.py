@@ -16,7 +16,8 @@ below. This script, in one run:
 2. measures this CPU's float32 matmul rate at ``--threads`` threads: the best of
    ``--repeats`` runs of a square 2048 product and of the first projection's own shape,
    the faster taken (the more generous the rate, the safer the bound);
-3. times the forward itself (best of ``--repeats``) and Newton on the same garment
+3. times the forward itself (best of ``--repeats``), the products' own time inside one
+   profiled forward (so how far from the peak they run), and Newton on the same garment
    (``inference_speed.measure_simulator``);
 
 and prints the frames/s the dense products alone allow and their ratio to Newton. If that
@@ -36,6 +37,7 @@ import time
 from pathlib import Path
 
 import torch
+from torch.profiler import ProfilerActivity, profile
 from torch.utils._python_dispatch import TorchDispatchMode
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -125,6 +127,10 @@ def main() -> None:
             tic = time.perf_counter()
             model(context, *inputs)
             forward = min(forward, time.perf_counter() - tic)
+        with profile(activities=[ProfilerActivity.CPU]) as profiled:
+            model(context, *inputs)
+    in_forward = sum(event.self_cpu_time_total for event in profiled.key_averages()
+                     if event.key in ("aten::mm", "aten::addmm", "aten::bmm")) / 1e6
     largest = max(counter.shapes, key=lambda s: s[0] * s[1] * s[2])
     rates = {"square 2048": matmul_rate(2048, 2048, 2048, args.repeats),
              f"largest projection {largest}": matmul_rate(*largest, args.repeats)}
@@ -137,6 +143,9 @@ def main() -> None:
         print(f"matmul rate, {name}: {rate:.1f} GFLOP/s")
     print(f"forward at the peak rate ({peak:.1f} GFLOP/s), dense products only: "
           f"{floor * 1000:.1f} ms = {args.batch / floor:.0f} frames/s at most")
+    print(f"dense products inside one profiled forward: {in_forward * 1000:.1f} ms of "
+          f"self time (sparse ones included) = {counter.flops / in_forward / 1e9:.1f} "
+          "GFLOP/s")
     print(f"forward measured (best of {args.repeats}): {forward * 1000:.1f} ms = "
           f"{args.batch / forward:.1f} frames/s; the dense floor is "
           f"{floor / forward:.0%} of it")
