@@ -58,8 +58,8 @@ for path in (ROOT, ROOT / "benchmarks"):
 from dynamics_bounds import Sequence, blended_frames, pose_features  # noqa: E402
 from motion_count_bounds import (  # noqa: E402
     chosen_windows,
-    load_sequence,
     simulate_all,
+    simulated_split,
     window_plans,
 )
 from skinning_bounds import fit_weights, vertex_error_mm  # noqa: E402
@@ -148,6 +148,10 @@ def fit_and_score(train: list[np.ndarray], residuals: list[np.ndarray],
     steps_per_epoch = max(samples // 4096, 1)
     optimiser = torch.optim.Adam(network.parameters(), lr=1e-3)
     schedule = torch.optim.lr_scheduler.CosineAnnealingLR(optimiser, epochs * steps_per_epoch)
+    # Each test sequence's skinning frames and skinned positions, computed once.
+    references = [(torch.from_numpy(inputs.reshape(-1, inputs.shape[-1])), inputs.shape[:2],
+                   blended_frames(sequence.transforms, weights), sequence.skinned(weights),
+                   sequence.target) for inputs, sequence in test]
     errors = []
     for _ in range(epochs):
         network.train()
@@ -161,14 +165,11 @@ def fit_and_score(train: list[np.ndarray], residuals: list[np.ndarray],
         network.eval()
         scores = []
         with torch.no_grad():
-            for inputs, sequence in test:
-                flat = torch.from_numpy(inputs.reshape(-1, inputs.shape[-1]))
+            for flat, shape, frames, skinned, target in references:
                 offsets = (network((flat - mean) / scale).numpy().astype(np.float64)
-                           / 1000.0).reshape(*inputs.shape[:2], 3)
-                carried = np.einsum("tnab,tnb->tna",
-                                    blended_frames(sequence.transforms, weights), offsets)
-                scores.append(vertex_error_mm(sequence.skinned(weights) + carried,
-                                              sequence.target))
+                           / 1000.0).reshape(*shape, 3)
+                carried = np.einsum("tnab,tnb->tna", frames, offsets)
+                scores.append(vertex_error_mm(skinned + carried, target))
         errors.append(float(np.mean(scores)))
     return errors
 
@@ -211,10 +212,7 @@ def main() -> None:
     rows = []
     for garment, group in plans.items():
         started = time.perf_counter()
-        loaded = [(p, load_sequence(args.work, p, config)) for p in group]
-        loaded = [(p, s) for p, s in loaded if s is not None]
-        train = [(p, s) for p, s in loaded if p.motion.name not in test_names]
-        test = [(p, s) for p, s in loaded if p.motion.name in test_names]
+        train, test = simulated_split(args.work, group, config, test_names)
         if len(train) < 2 or not test:
             print(f"{garment}: too few simulated sequences ({len(train)} train, "
                   f"{len(test)} test)", flush=True)

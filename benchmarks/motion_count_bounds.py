@@ -198,6 +198,17 @@ def load_sequence(work: Path, plan: SequencePlan, config: DataConfig) -> Sequenc
                         stored["answer"], config.fps)
 
 
+def simulated_split(work: Path, group: list[SequencePlan], config: DataConfig,
+                    test_names: set[str]) -> tuple[list[tuple[SequencePlan, Sequence]],
+                                                   list[tuple[SequencePlan, Sequence]]]:
+    """The simulated sequences of ``group`` (those the simulator left out skipped) with
+    their plans, split into training and test windows by the test windows' names."""
+    loaded = [(p, load_sequence(work, p, config)) for p in group]
+    loaded = [(p, s) for p, s in loaded if s is not None]
+    return ([(p, s) for p, s in loaded if p.motion.name not in test_names],
+            [(p, s) for p, s in loaded if p.motion.name in test_names])
+
+
 def shipped_model_errors(work: Path, tests: list[tuple[SequencePlan, Sequence]],
                          config: DataConfig) -> list[float]:
     """E_verts (mm) of the shipped model as ``animate`` runs it, per test sequence."""
@@ -304,9 +315,8 @@ def main() -> None:
     names = {m.name for m in test_windows}
     summary = []
     for garment, group in plans.items():
-        loaded = [(p, load_sequence(args.work, p, config)) for p in group]
-        train = [s for p, s in loaded if s is not None and p.motion.name not in names]
-        test = [(p, s) for p, s in loaded if s is not None and p.motion.name in names]
+        train_plans, test = simulated_split(args.work, group, config, names)
+        train = [s for _, s in train_plans]
         if not train or not test:
             print(f"{garment}: too few simulated sequences ({len(train)} train, {len(test)} "
                   "test)")
