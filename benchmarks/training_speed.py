@@ -11,6 +11,7 @@ mixed garments).
     .venv/bin/python benchmarks/training_speed.py [--config configs/train/demo.yaml]
         [--data data/demo] [--steps 10] [--threads 1] [--deterministic on|off|both]
         [--processes 1] [--set pairs_per_batch=1 ...] [--attention-path fused pytorch]
+        [--profile ROWS]
 
 ``--attention-path fused pytorch`` measures the same run with the GAT layers on the fused
 C++ operator (:mod:`gnngarment.model.fused_attention`) and on its PyTorch fallback, one
@@ -63,11 +64,14 @@ STAGES = ("supervised", "physics", "physics_strain")
 
 
 def measure(config_path: Path, data: Path, steps: int, threads: int,
-            deterministic: bool = True, overrides: list[str] | None = None) -> dict:
+            deterministic: bool = True, overrides: list[str] | None = None,
+            profile_rows: int = 0) -> dict:
     """Seconds per optimiser step (:meth:`Trainer.step`) for each stage, the first step of
-    each stage discarded as a warm-up. Returns a JSON-able dict. Inside a process group
-    (``--processes``) every rank steps on its own batches and the figures are the
-    group's: frames of all ranks, the slowest rank's seconds."""
+    each stage discarded as a warm-up. With ``profile_rows``, each stage's steps after
+    the warm-up also run once more under torch's profiler and its table of that many
+    operators (by self time) is kept under ``"profile"``. Returns a JSON-able dict.
+    Inside a process group (``--processes``) every rank steps on its own batches and the
+    figures are the group's: frames of all ranks, the slowest rank's seconds."""
     config = load_training_config(config_path, [f"data={data}", f"threads={threads}",
                                                 f"deterministic={deterministic}",
                                                 *(overrides or [])])
@@ -108,6 +112,14 @@ def measure(config_path: Path, data: Path, steps: int, threads: int,
         results["stages"][stage] = {
             "seconds_per_step": seconds / steps, "median_seconds_per_step": median,
             "frames_per_second": frames / seconds, "vertices_per_second": vertices / seconds}
+        if profile_rows:
+            from torch.profiler import ProfilerActivity, profile
+
+            with profile(activities=[ProfilerActivity.CPU]) as profiled:
+                for index in range(1, steps + 1):
+                    trainer.step(groups[(index * world + rank) % len(groups)])
+            results["stages"][stage]["profile"] = profiled.key_averages().table(
+                sort_by="self_cpu_time_total", row_limit=profile_rows)
     return results
 
 
@@ -153,6 +165,9 @@ def main() -> None:
                         default=["auto"],
                         help="GAT path(s) to measure, each a run of its own (auto: the "
                              "library's choice)")
+    parser.add_argument("--profile", type=int, default=0, metavar="ROWS",
+                        help="also profile each stage's steps once more and print its "
+                             "ROWS operators of most self time")
     parser.add_argument("--json", type=Path, help="also write the results here")
     args = parser.parse_args()
     if args.processes < 1:
@@ -176,7 +191,7 @@ def main() -> None:
             reason = fallback_reason(grad=True)
             for mode in modes:
                 results = (measure(args.config, args.data, args.steps, args.threads, mode,
-                                   args.set)
+                                   args.set, args.profile)
                            if args.processes == 1 else measure_in_processes(args, mode))
                 results["attention_path"] = path
                 results["path"] = training_path + (f" ({reason})" if reason else "")
@@ -193,6 +208,9 @@ def main() -> None:
             print(f"| {stage} | {row['seconds_per_step']:.3f} | "
                   f"{row['median_seconds_per_step']:.3f} | {row['frames_per_second']:.1f} | "
                   f"{row['vertices_per_second']:.0f} |")
+        for stage, row in results["stages"].items():
+            if "profile" in row:
+                print(f"profile of {args.steps} {stage} steps:\n{row['profile']}")
     median = "median_seconds_per_step"
     if len(modes) == 2:
         for before, after in zip(runs[::2], runs[1::2], strict=True):
