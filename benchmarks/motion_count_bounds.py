@@ -39,7 +39,8 @@ model of that class reach further; a flat one says the class is the limit.
         [--responses diagonal pose diagonal+pose nearest] [--neighbours 5]
 
 Simulations (~20 s each on one core) are saved under ``--work``/motion_count, so an
-interrupted run resumes; ``--workers`` run them in parallel processes of one thread.
+interrupted run resumes (a sequence the simulator left out is recorded there too, with
+its reason, and not retried); ``--workers`` run them in parallel processes of one thread.
 """
 
 from __future__ import annotations
@@ -154,6 +155,12 @@ def _saved(work: Path, plan: SequencePlan) -> Path:
     return work / "motion_count" / f"{plan.name}.npz"
 
 
+def _left_out(work: Path, plan: SequencePlan) -> Path:
+    """Where the simulator's reason for leaving ``plan`` out is kept, so that a later
+    run does not simulate it again."""
+    return work / "motion_count" / f"{plan.name}.left_out.txt"
+
+
 def _simulate(task: tuple[str, SequencePlan, DataConfig]) -> tuple[str, str]:
     """One sequence, saved atomically (a worker process of one thread)."""
     work, plan, config = Path(task[0]), task[1], task[2]
@@ -161,6 +168,7 @@ def _simulate(task: tuple[str, SequencePlan, DataConfig]) -> tuple[str, str]:
     started = time.perf_counter()
     runs = simulate_starts(work, plan, config, {"answer": None})
     if isinstance(runs, str):
+        atomic_write_bytes(_left_out(work, plan), runs.encode())
         return plan.name, f"left out: {runs}"
     runs["seconds"] = np.array(time.perf_counter() - started)
     buffer = io.BytesIO()
@@ -171,10 +179,12 @@ def _simulate(task: tuple[str, SequencePlan, DataConfig]) -> tuple[str, str]:
 
 def simulate_all(work: Path, plans: list[SequencePlan], config: DataConfig,
                  workers: int) -> None:
-    todo = [p for p in plans if not _saved(work, p).is_file()]
+    todo = [p for p in plans
+            if not _saved(work, p).is_file() and not _left_out(work, p).is_file()]
     (work / "motion_count").mkdir(parents=True, exist_ok=True)
-    print(f"{len(plans) - len(todo)} of {len(plans)} sequences already simulated; "
-          f"{len(todo)} to go on {workers} worker(s)", file=sys.stderr, flush=True)
+    print(f"{len(plans) - len(todo)} of {len(plans)} sequences already simulated or left "
+          f"out by the simulator; {len(todo)} to go on {workers} worker(s)",
+          file=sys.stderr, flush=True)
     tasks = [(str(work), p, config) for p in todo]
     def report(results) -> None:
         for done, (name, status) in enumerate(results, 1):
