@@ -7,7 +7,10 @@ of the neighbours' projected features. In PyTorch that is several passes over
 C++ operator in ``csrc/graph_attention.cpp`` (``torch.ops.gnngarment.*``, registered
 with ``TORCH_LIBRARY``) does it in one pass over each CSR row, parallel over rows, and
 its backward recomputes the softmax from the saved per-row maxima and sums (nothing per
-edge is stored). The PyTorch path stays as the fallback and the reference.
+edge is kept from the forward; inside the backward, the row pass hands each edge's
+softmax weight and logit gradient to the column pass, 2 values per edge and head, so the
+per-edge dot product is computed once). The PyTorch path stays as the fallback and the
+reference.
 
 **How it is built**: compiled on first use (the first GAT forward, or
 :func:`attention_path`) by the C++ compiler found on ``PATH`` (``$CXX``, ``c++``,
@@ -172,9 +175,10 @@ def _forward(h: torch.Tensor, a_src: torch.Tensor, a_dst: torch.Tensor, bias: to
     return tuple(torch.cat(column) for column in zip(*parts, strict=True))  # type: ignore[return-value]
 
 
-def _transpose(graph: AttentionGraph) -> tuple[torch.Tensor, torch.Tensor]:
-    """``(ptr_t, target)``: the edges out of node ``j`` go to ``target[ptr_t[j]:ptr_t[j+1]]``
-    (repeated edges kept; a stable sort, so the order is deterministic)."""
+def _transpose(graph: AttentionGraph) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """``(ptr_t, target, edge_t)``: the edges out of node ``j`` go to
+    ``target[ptr_t[j]:ptr_t[j+1]]`` and are edges ``edge_t[ptr_t[j]:ptr_t[j+1]]`` of the
+    graph's CSR order (repeated edges kept; a stable sort, so the order is deterministic)."""
     cached = _transposes.get(graph)
     if cached is None:
         with structure_mode():
@@ -184,7 +188,7 @@ def _transpose(graph: AttentionGraph) -> tuple[torch.Tensor, torch.Tensor]:
             order = torch.argsort(graph.source, stable=True)
             counts = torch.bincount(graph.source, minlength=n)
             ptr_t = torch.cat([counts.new_zeros(1), torch.cumsum(counts, 0)])
-            cached = (ptr_t, target[order].contiguous())
+            cached = (ptr_t, target[order].contiguous(), order.contiguous())
         _transposes[graph] = cached
     return cached
 
@@ -210,10 +214,10 @@ class _FusedGraphAttention(torch.autograd.Function):
         parts, node = [], 0
         for block, copies in _blocks(ctx.graph):
             rows = slice(node, node + copies * block.num_nodes)
-            ptr_t, target = _transpose(block)
-            parts.append(op(block.ptr, block.source, ptr_t, target, copies, grad[rows],
-                            h[rows], a_src[rows], a_dst[rows], row_max[rows], row_sum[rows],
-                            ctx.negative_slope, ctx.concat))
+            ptr_t, target, edge_t = _transpose(block)
+            parts.append(op(block.ptr, block.source, ptr_t, target, edge_t, copies,
+                            grad[rows], h[rows], a_src[rows], a_dst[rows], row_max[rows],
+                            row_sum[rows], ctx.negative_slope, ctx.concat))
             node = rows.stop
         grad_h, grad_src, grad_dst = (parts[0] if len(parts) == 1 else
                                       tuple(torch.cat(c) for c in zip(*parts, strict=True)))
@@ -343,8 +347,8 @@ def _register_fake() -> None:
                 a_src.new_empty(a_src.shape))
 
     @torch.library.register_fake("gnngarment::graph_attention_backward")
-    def _backward_fake(ptr, source, ptr_t, target, copies, grad, h, a_src, a_dst, row_max,
-                       row_sum, negative_slope, concat):
+    def _backward_fake(ptr, source, ptr_t, target, edge_t, copies, grad, h, a_src, a_dst,
+                       row_max, row_sum, negative_slope, concat):
         return h.new_empty(h.shape), a_src.new_empty(a_src.shape), a_src.new_empty(a_src.shape)
 
     _register_fake.done = True  # type: ignore[attr-defined]

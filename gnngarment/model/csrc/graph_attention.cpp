@@ -15,6 +15,10 @@
 //     dz_e = alpha_e (g_e - D[i, k]) leaky_relu'(z_e);
 //   * a column pass (parallel over sources, on the transposed graph) gives grad h[j] =
 //     sum over j's outgoing edges of alpha_e dout[i, k, :] and grad a_src[j, k] = sum dz_e.
+// The row pass keeps alpha_e and dz_e of every edge (2 values per edge and head, freed
+// when the backward returns) for the column pass, which reads them through the transposed
+// graph's edge numbers: recomputing them there repeated the row pass's per-edge dot
+// product <dout, h> (a third of the backward's multiply-adds).
 // Every output element is written by one thread in a fixed order: results do not depend
 // on the number of threads, and no atomics are needed.
 
@@ -287,23 +291,28 @@ void forward_kernel(const int64_t* ptr, const int64_t* source, const Shape s, co
   });
 }
 
-// Backward, destination side: D[i, k] and grad a_dst.
+// Backward, destination side: grad a_dst, and per edge e (numbered copy * edges + its
+// place in the base graph's CSR) and head k the coefficient of dout[i] in grad h[j]
+// (alpha_e times the head mean's scale) and dz_e.
 template <typename T, int64_t kHeads>
 void backward_rows(const int64_t* ptr, const int64_t* source, const Shape s, const T* grad,
                    const T* h, const T* a_src, const T* a_dst, const T* row_max,
-                   const T* row_sum, T slope, T* expected, T* grad_a_dst) {
+                   const T* row_sum, T slope, int64_t edges, T* grad_a_dst,
+                   T* edge_coefficient, T* edge_dz) {
   // kHeads > 0: the head count known at compile time (its loops unrolled).
   const int64_t heads = kHeads > 0 ? kHeads : s.heads;
   const int64_t channels = s.channels, width = s.width();
   const int64_t stride = heads * channels;
   const T scale = s.concat ? T(1) : T(1) / T(heads);
   at::parallel_for(0, s.rows(), kGrain, [&](int64_t begin, int64_t end) {
-    std::vector<T> alpha, derivative, upstream, inverse(heads), maximum(heads), total(heads);
+    std::vector<T> alpha, derivative, upstream, inverse(heads), maximum(heads), total(heads),
+        d(heads);
     RowCursor cursor(begin, s.nodes);
     for (int64_t i = begin; i < end; ++i, cursor.next()) {
       prefetch_ahead(cursor, end, i, ptr, source, h, stride, stride * sizeof(T), a_src,
                      s.src_stride, heads * sizeof(T));
       const int64_t first = ptr[cursor.base], degree = ptr[cursor.base + 1] - first;
+      const int64_t edge_base = (cursor.offset / s.nodes) * edges + first;
       const int64_t* neighbours = source + first;
       alpha.resize(degree * heads);
       derivative.resize(degree * heads);
@@ -315,8 +324,7 @@ void backward_rows(const int64_t* ptr, const int64_t* source, const Shape s, con
       row_softmax(alpha.data(), derivative.data(), degree, heads, slope, T(1), false,
                   maximum.data(), total.data(), inverse.data());
       const T* grad_row = grad + i * width;
-      T* d = expected + i * heads;
-      std::fill(d, d + heads, T(0));
+      std::fill(d.begin(), d.end(), T(0));
       for (int64_t e = 0; e < degree; ++e) {
         const T* features = h + (neighbours[e] + cursor.offset) * stride;
         for (int64_t k = 0; k < heads; ++k) {
@@ -327,69 +335,57 @@ void backward_rows(const int64_t* ptr, const int64_t* source, const Shape s, con
         }
       }
       T* grad_dst = grad_a_dst + i * heads;
+      T* coefficient = edge_coefficient + edge_base * heads;
+      T* dz = edge_dz + edge_base * heads;
       std::fill(grad_dst, grad_dst + heads, T(0));
       for (int64_t e = 0; e < degree; ++e)
-        for (int64_t k = 0; k < heads; ++k)
-          grad_dst[k] += alpha[e * heads + k] * (upstream[e * heads + k] - d[k]) *
-                         derivative[e * heads + k];
+        for (int64_t k = 0; k < heads; ++k) {
+          const T value = alpha[e * heads + k] * (upstream[e * heads + k] - d[k]) *
+                          derivative[e * heads + k];
+          grad_dst[k] += value;
+          dz[e * heads + k] = value;
+          coefficient[e * heads + k] = alpha[e * heads + k] * scale;
+        }
     }
   });
 }
 
 // Backward, source side (transposed graph: ptr_t / target list the edges out of each
-// node): grad h and grad a_src.
+// node, edge_t their numbers in the base graph's CSR): grad h and grad a_src, from the
+// row pass's per-edge coefficients and dz.
 template <typename T, int64_t kHeads>
-void backward_columns(const int64_t* ptr_t, const int64_t* target, const Shape s,
-                      const T* grad, const T* h, const T* a_src, const T* a_dst,
-                      const T* row_max, const T* row_sum, const T* expected, T slope,
-                      T* grad_h, T* grad_a_src) {
+void backward_columns(const int64_t* ptr_t, const int64_t* target, const int64_t* edge_t,
+                      const Shape s, const T* grad, const T* edge_coefficient,
+                      const T* edge_dz, int64_t edges, T* grad_h, T* grad_a_src) {
   // kHeads > 0: the head count known at compile time (its loops unrolled).
   const int64_t heads = kHeads > 0 ? kHeads : s.heads;
   const int64_t channels = s.channels, width = s.width();
   const int64_t stride = heads * channels;
-  const T scale = s.concat ? T(1) : T(1) / T(heads);
   at::parallel_for(0, s.rows(), kGrain, [&](int64_t begin, int64_t end) {
-    std::vector<T> alpha, derivative;
+    std::vector<T> coefficient;
     RowCursor cursor(begin, s.nodes);
     for (int64_t j = begin; j < end; ++j, cursor.next()) {
-      prefetch_ahead(cursor, end, j, ptr_t, target, grad, width, width * sizeof(T), a_dst,
-                     s.dst_stride, heads * sizeof(T));
+      prefetch_ahead(cursor, end, j, ptr_t, target, grad, width, width * sizeof(T), grad,
+                     width, 0);
       const int64_t first = ptr_t[cursor.base], degree = ptr_t[cursor.base + 1] - first;
       const int64_t* destinations = target + first;
-      const int64_t offset = cursor.offset;
-      alpha.resize(degree * heads);
-      derivative.resize(degree * heads);
-      const T* source_scores = a_src + j * s.src_stride;
-      for (int64_t e = 0; e < degree; ++e) {
-        const int64_t i = destinations[e] + offset;
-        const T* dst = a_dst + i * s.dst_stride;
-        for (int64_t k = 0; k < heads; ++k) {
-          const T z = source_scores[k] + dst[k];
-          derivative[e * heads + k] = leaky_relu_derivative(z, slope);
-          alpha[e * heads + k] = leaky_relu(z, slope) - row_max[i * heads + k];
-        }
-      }
-      exp_in_place(alpha.data(), degree * heads);
-      const T* features = h + j * stride;
+      const int64_t* numbers = edge_t + first;
+      const int64_t copy_edges = (cursor.offset / s.nodes) * edges;
+      coefficient.resize(degree * heads);
       T* grad_src = grad_a_src + j * heads;
       std::fill(grad_src, grad_src + heads, T(0));
       for (int64_t e = 0; e < degree; ++e) {
-        const int64_t i = destinations[e] + offset;
-        const T* grad_row = grad + i * width;
+        const int64_t edge = (copy_edges + numbers[e]) * heads;
         for (int64_t k = 0; k < heads; ++k) {
-          // alpha * scale: the coefficient of grad_row in grad h.
-          const T a = alpha[e * heads + k] * scale / row_sum[i * heads + k];
-          alpha[e * heads + k] = a;
-          const T g = dot(s.concat ? grad_row + k * channels : grad_row,
-                          features + k * channels, channels);
-          // dz = alpha (scale g - D) leaky'(z), with alpha = a / scale.
-          grad_src[k] += a * (g - expected[i * heads + k] / scale) * derivative[e * heads + k];
+          coefficient[e * heads + k] = edge_coefficient[edge + k];
+          grad_src[k] += edge_dz[edge + k];
         }
       }
       T* grad_features = grad_h + j * stride;
       for (int64_t k = 0; k < heads; ++k)
-        weighted_rows(grad_features + k * channels, channels, destinations, offset, degree,
-                      alpha.data() + k, heads, grad + (s.concat ? k * channels : 0), width);
+        weighted_rows(grad_features + k * channels, channels, destinations, cursor.offset,
+                      degree, coefficient.data() + k, heads,
+                      grad + (s.concat ? k * channels : 0), width);
     }
   });
 }
@@ -462,12 +458,15 @@ std::tuple<at::Tensor, at::Tensor, at::Tensor> graph_attention_forward(
 
 std::tuple<at::Tensor, at::Tensor, at::Tensor> graph_attention_backward(
     const at::Tensor& ptr, const at::Tensor& source, const at::Tensor& ptr_t,
-    const at::Tensor& target, int64_t copies, const at::Tensor& grad, const at::Tensor& h,
+    const at::Tensor& target, const at::Tensor& edge_t, int64_t copies,
+    const at::Tensor& grad, const at::Tensor& h,
     const at::Tensor& a_src, const at::Tensor& a_dst, const at::Tensor& row_max,
     const at::Tensor& row_sum, double negative_slope, bool concat) {
   const Shape s = check_inputs(ptr, source, copies, h, a_src, a_dst, concat);
   check_graph(ptr_t, target, "transposed graph");
-  TORCH_CHECK(ptr_t.numel() == ptr.numel() && target.numel() == source.numel(),
+  check_graph(ptr_t, edge_t, "transposed graph's edge numbers");
+  TORCH_CHECK(ptr_t.numel() == ptr.numel() && target.numel() == source.numel() &&
+                  edge_t.numel() == source.numel(),
               "the transposed graph must have the graph's nodes and edges");
   const int64_t rows = s.rows();
   TORCH_CHECK(grad.dim() == 2 && grad.size(0) == rows && grad.size(1) == s.width() &&
@@ -477,24 +476,26 @@ std::tuple<at::Tensor, at::Tensor, at::Tensor> graph_attention_backward(
                   row_max.is_contiguous() && row_sum.is_contiguous(),
               "row_max and row_sum must be contiguous (N, heads), as the forward gave them");
   const at::Tensor grad_ = grad.contiguous();
-  at::Tensor expected = at::empty({rows, s.heads}, h.options());
+  const int64_t edges = source.numel();
+  at::Tensor edge_coefficient = at::empty({s.copies * edges, s.heads}, h.options());
+  at::Tensor edge_dz = at::empty({s.copies * edges, s.heads}, h.options());
   at::Tensor grad_h = at::empty_like(h);
   at::Tensor grad_a_src = at::empty({rows, s.heads}, h.options());
   at::Tensor grad_a_dst = at::empty({rows, s.heads}, h.options());
   AT_DISPATCH_FLOATING_TYPES(h.scalar_type(), "graph_attention_backward", [&] {
     const auto slope = static_cast<scalar_t>(negative_slope);
     const auto run = [&](auto heads) {
-    backward_rows<scalar_t, decltype(heads)::value>(ptr.data_ptr<int64_t>(), source.data_ptr<int64_t>(), s,
-                            grad_.data_ptr<scalar_t>(), h.data_ptr<scalar_t>(),
-                            a_src.data_ptr<scalar_t>(), a_dst.data_ptr<scalar_t>(),
-                            row_max.data_ptr<scalar_t>(), row_sum.data_ptr<scalar_t>(), slope,
-                            expected.data_ptr<scalar_t>(), grad_a_dst.data_ptr<scalar_t>());
-    backward_columns<scalar_t, decltype(heads)::value>(ptr_t.data_ptr<int64_t>(), target.data_ptr<int64_t>(), s,
-                               grad_.data_ptr<scalar_t>(), h.data_ptr<scalar_t>(),
-                               a_src.data_ptr<scalar_t>(), a_dst.data_ptr<scalar_t>(),
-                               row_max.data_ptr<scalar_t>(), row_sum.data_ptr<scalar_t>(),
-                               expected.data_ptr<scalar_t>(), slope,
-                               grad_h.data_ptr<scalar_t>(), grad_a_src.data_ptr<scalar_t>());
+    backward_rows<scalar_t, decltype(heads)::value>(
+        ptr.data_ptr<int64_t>(), source.data_ptr<int64_t>(), s, grad_.data_ptr<scalar_t>(),
+        h.data_ptr<scalar_t>(), a_src.data_ptr<scalar_t>(), a_dst.data_ptr<scalar_t>(),
+        row_max.data_ptr<scalar_t>(), row_sum.data_ptr<scalar_t>(), slope, edges,
+        grad_a_dst.data_ptr<scalar_t>(), edge_coefficient.data_ptr<scalar_t>(),
+        edge_dz.data_ptr<scalar_t>());
+    backward_columns<scalar_t, decltype(heads)::value>(
+        ptr_t.data_ptr<int64_t>(), target.data_ptr<int64_t>(), edge_t.data_ptr<int64_t>(), s,
+        grad_.data_ptr<scalar_t>(), edge_coefficient.data_ptr<scalar_t>(),
+        edge_dz.data_ptr<scalar_t>(), edges, grad_h.data_ptr<scalar_t>(),
+        grad_a_src.data_ptr<scalar_t>());
     };
     with_heads(s.heads, run);
   });
@@ -510,7 +511,8 @@ TORCH_LIBRARY(gnngarment, m) {
       "-> (Tensor, Tensor, Tensor)");
   m.def(
       "graph_attention_backward(Tensor ptr, Tensor source, Tensor ptr_t, Tensor target, "
-      "int copies, Tensor grad, Tensor h, Tensor a_src, Tensor a_dst, Tensor row_max, "
+      "Tensor edge_t, int copies, Tensor grad, Tensor h, Tensor a_src, Tensor a_dst, "
+      "Tensor row_max, "
       "Tensor row_sum, float negative_slope, bool concat) -> (Tensor, Tensor, Tensor)");
 }
 
