@@ -158,21 +158,13 @@ def _blocks(graph: AttentionGraph) -> list[tuple[AttentionGraph, int]]:
 def _forward(h: torch.Tensor, a_src: torch.Tensor, a_dst: torch.Tensor, bias: torch.Tensor,
              graph: AttentionGraph, negative_slope: float, concat: bool
              ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """``(out, row_max, row_sum)``, block by block (every copy reads its block's one set
-    of index arrays)."""
-    op = torch.ops.gnngarment.graph_attention_forward
-    parts, node = [], 0
-    bias = bias.detach()
-    for block, copies in _blocks(graph):
-        rows = slice(node, node + copies * block.num_nodes)
-        parts.append(op(block.ptr, block.source, copies, h[rows], a_src[rows], a_dst[rows],
-                        bias, negative_slope, concat))
-        node = rows.stop
-    if node != h.shape[0]:
-        raise ValueError(f"graph has {node} nodes, h has {h.shape[0]} rows")
-    if len(parts) == 1:
-        return parts[0]
-    return tuple(torch.cat(column) for column in zip(*parts, strict=True))  # type: ignore[return-value]
+    """``(out, row_max, row_sum)``: one operator call over every block (each copy reads
+    its block's one set of index arrays; the blocks write into one output)."""
+    blocks = _blocks(graph)
+    return torch.ops.gnngarment.graph_attention_forward(
+        [block.ptr for block, _ in blocks], [block.source for block, _ in blocks],
+        [copies for _, copies in blocks], h, a_src, a_dst, bias.detach(), negative_slope,
+        concat)
 
 
 def _transpose(graph: AttentionGraph) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
@@ -210,17 +202,13 @@ class _FusedGraphAttention(torch.autograd.Function):
     def backward(ctx, grad: torch.Tensor):  # type: ignore[override]
         h, a_src, a_dst, row_max, row_sum = ctx.saved_tensors
         grad = grad.contiguous()
-        op = torch.ops.gnngarment.graph_attention_backward
-        parts, node = [], 0
-        for block, copies in _blocks(ctx.graph):
-            rows = slice(node, node + copies * block.num_nodes)
-            ptr_t, target, edge_t = _transpose(block)
-            parts.append(op(block.ptr, block.source, ptr_t, target, edge_t, copies,
-                            grad[rows], h[rows], a_src[rows], a_dst[rows], row_max[rows],
-                            row_sum[rows], ctx.negative_slope, ctx.concat))
-            node = rows.stop
-        grad_h, grad_src, grad_dst = (parts[0] if len(parts) == 1 else
-                                      tuple(torch.cat(c) for c in zip(*parts, strict=True)))
+        blocks = _blocks(ctx.graph)
+        transposes = [_transpose(block) for block, _ in blocks]
+        grad_h, grad_src, grad_dst = torch.ops.gnngarment.graph_attention_backward(
+            [block.ptr for block, _ in blocks], [block.source for block, _ in blocks],
+            [t[0] for t in transposes], [t[1] for t in transposes],
+            [t[2] for t in transposes], [copies for _, copies in blocks], grad, h, a_src,
+            a_dst, row_max, row_sum, ctx.negative_slope, ctx.concat)
         grad_bias = grad.sum(0) if ctx.needs_input_grad[3] else None
         return grad_h, grad_src, grad_dst, grad_bias, None, None, None
 

@@ -176,7 +176,7 @@ def test_bad_inputs_are_rejected() -> None:
     scores = torch.randn(59, 4)
     with pytest.raises(RuntimeError, match="rows"):
         torch.ops.gnngarment.graph_attention_forward(
-            graph.ptr, graph.source, 1, h, scores, scores, torch.zeros(2), 0.2, False)
+            [graph.ptr], [graph.source], [1], h, scores, scores, torch.zeros(2), 0.2, False)
 
 
 def test_a_machine_without_a_compiler_runs_the_pytorch_path(tmp_path) -> None:

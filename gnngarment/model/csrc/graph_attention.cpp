@@ -432,73 +432,128 @@ Shape check_inputs(const at::Tensor& ptr, const at::Tensor& source, int64_t copi
                concat};
 }
 
+// The blocks of a batch: block b is copies[b] copies of the graph (ptr[b], source[b]),
+// its rows following block b - 1's. One call runs them all into one output, so that a
+// batch of several garments needs no concatenation of per-garment results.
+int64_t check_blocks(at::TensorList ptr, at::TensorList source, at::IntArrayRef copies,
+                     const at::Tensor& h) {
+  TORCH_CHECK(ptr.size() == source.size() && ptr.size() == copies.size(),
+              "ptr, source and copies must have one entry per block");
+  int64_t rows = 0;
+  for (size_t b = 0; b < ptr.size(); ++b) {
+    check_graph(ptr[b], source[b], "graph");
+    TORCH_CHECK(copies[b] >= 0, "copies must be >= 0");
+    rows += (ptr[b].numel() - 1) * copies[b];
+  }
+  TORCH_CHECK(h.dim() == 2 && h.size(0) == rows, "the graph has ", rows,
+              " rows (nodes of every copy of every block), h has ",
+              h.dim() == 2 ? h.size(0) : -1);
+  return rows;
+}
+
 std::tuple<at::Tensor, at::Tensor, at::Tensor> graph_attention_forward(
-    const at::Tensor& ptr, const at::Tensor& source, int64_t copies, const at::Tensor& h,
+    at::TensorList ptr, at::TensorList source, at::IntArrayRef copies, const at::Tensor& h,
     const at::Tensor& a_src, const at::Tensor& a_dst, const at::Tensor& bias,
     double negative_slope, bool concat) {
-  const Shape s = check_inputs(ptr, source, copies, h, a_src, a_dst, concat);
+  const int64_t rows = check_blocks(ptr, source, copies, h);
+  TORCH_CHECK(a_src.dim() == 2 && a_src.size(0) == rows && a_dst.dim() == 2 &&
+                  a_dst.size(0) == rows,
+              "a_src and a_dst must have the graph's ", rows, " rows");
+  const int64_t heads = a_src.size(1);
+  TORCH_CHECK(heads > 0 && h.size(1) % heads == 0,
+              "h must be a contiguous (N, heads * channels) matrix");
+  const int64_t width = concat ? h.size(1) : h.size(1) / heads;
   const at::Tensor bias_ = bias.to(h.scalar_type()).contiguous();
-  TORCH_CHECK(bias_.numel() == s.width(), "bias must have ", s.width(), " values");
-  const int64_t rows = s.rows();
-  at::Tensor out = at::empty({rows, s.width()}, h.options());
-  at::Tensor row_max = at::empty({rows, s.heads}, h.options());
-  at::Tensor row_sum = at::empty({rows, s.heads}, h.options());
-  AT_DISPATCH_FLOATING_TYPES(h.scalar_type(), "graph_attention_forward", [&] {
-    const auto run = [&](auto heads) {
-      forward_kernel<scalar_t, decltype(heads)::value>(
-          ptr.data_ptr<int64_t>(), source.data_ptr<int64_t>(), s, h.data_ptr<scalar_t>(),
-          a_src.data_ptr<scalar_t>(), a_dst.data_ptr<scalar_t>(), bias_.data_ptr<scalar_t>(),
-          static_cast<scalar_t>(negative_slope), out.data_ptr<scalar_t>(),
-          row_max.data_ptr<scalar_t>(), row_sum.data_ptr<scalar_t>());
-    };
-    with_heads(s.heads, run);
-  });
+  TORCH_CHECK(bias_.numel() == width, "bias must have ", width, " values");
+  at::Tensor out = at::empty({rows, width}, h.options());
+  at::Tensor row_max = at::empty({rows, heads}, h.options());
+  at::Tensor row_sum = at::empty({rows, heads}, h.options());
+  int64_t first = 0;
+  for (size_t b = 0; b < ptr.size(); ++b) {
+    const int64_t count = (ptr[b].numel() - 1) * copies[b];
+    const auto part = [&](const at::Tensor& t) { return t.narrow(0, first, count); };
+    const at::Tensor h_b = part(h), a_src_b = part(a_src), a_dst_b = part(a_dst);
+    const Shape s = check_inputs(ptr[b], source[b], copies[b], h_b, a_src_b, a_dst_b, concat);
+    at::Tensor out_b = part(out), row_max_b = part(row_max), row_sum_b = part(row_sum);
+    AT_DISPATCH_FLOATING_TYPES(h.scalar_type(), "graph_attention_forward", [&] {
+      const auto run = [&](auto heads) {
+        forward_kernel<scalar_t, decltype(heads)::value>(
+            ptr[b].data_ptr<int64_t>(), source[b].data_ptr<int64_t>(), s,
+            h_b.data_ptr<scalar_t>(), a_src_b.data_ptr<scalar_t>(),
+            a_dst_b.data_ptr<scalar_t>(), bias_.data_ptr<scalar_t>(),
+            static_cast<scalar_t>(negative_slope), out_b.data_ptr<scalar_t>(),
+            row_max_b.data_ptr<scalar_t>(), row_sum_b.data_ptr<scalar_t>());
+      };
+      with_heads(s.heads, run);
+    });
+    first += count;
+  }
   return {out, row_max, row_sum};
 }
 
 std::tuple<at::Tensor, at::Tensor, at::Tensor> graph_attention_backward(
-    const at::Tensor& ptr, const at::Tensor& source, const at::Tensor& ptr_t,
-    const at::Tensor& target, const at::Tensor& edge_t, int64_t copies,
-    const at::Tensor& grad, const at::Tensor& h,
+    at::TensorList ptr, at::TensorList source, at::TensorList ptr_t, at::TensorList target,
+    at::TensorList edge_t, at::IntArrayRef copies, const at::Tensor& grad, const at::Tensor& h,
     const at::Tensor& a_src, const at::Tensor& a_dst, const at::Tensor& row_max,
     const at::Tensor& row_sum, double negative_slope, bool concat) {
-  const Shape s = check_inputs(ptr, source, copies, h, a_src, a_dst, concat);
-  check_graph(ptr_t, target, "transposed graph");
-  check_graph(ptr_t, edge_t, "transposed graph's edge numbers");
-  TORCH_CHECK(ptr_t.numel() == ptr.numel() && target.numel() == source.numel() &&
-                  edge_t.numel() == source.numel(),
-              "the transposed graph must have the graph's nodes and edges");
-  const int64_t rows = s.rows();
-  TORCH_CHECK(grad.dim() == 2 && grad.size(0) == rows && grad.size(1) == s.width() &&
-                  grad.scalar_type() == h.scalar_type(),
-              "grad must be (N, ", s.width(), ") of h's dtype");
+  const int64_t rows = check_blocks(ptr, source, copies, h);
+  TORCH_CHECK(ptr_t.size() == ptr.size() && target.size() == ptr.size() &&
+                  edge_t.size() == ptr.size(),
+              "the transposed graphs must have one entry per block");
+  TORCH_CHECK(a_src.dim() == 2 && a_src.size(0) == rows && a_dst.dim() == 2 &&
+                  a_dst.size(0) == rows,
+              "a_src and a_dst must have the graph's ", rows, " rows");
   TORCH_CHECK(row_max.sizes() == a_src.sizes() && row_sum.sizes() == a_src.sizes() &&
                   row_max.is_contiguous() && row_sum.is_contiguous(),
               "row_max and row_sum must be contiguous (N, heads), as the forward gave them");
+  const int64_t heads = a_src.size(1);
+  TORCH_CHECK(heads > 0 && h.size(1) % heads == 0,
+              "h must be a contiguous (N, heads * channels) matrix");
+  const int64_t width = concat ? h.size(1) : h.size(1) / heads;
+  TORCH_CHECK(grad.dim() == 2 && grad.size(0) == rows && grad.size(1) == width &&
+                  grad.scalar_type() == h.scalar_type(),
+              "grad must be (N, ", width, ") of h's dtype");
   const at::Tensor grad_ = grad.contiguous();
-  const int64_t edges = source.numel();
-  at::Tensor edge_coefficient = at::empty({s.copies * edges, s.heads}, h.options());
-  at::Tensor edge_dz = at::empty({s.copies * edges, s.heads}, h.options());
   at::Tensor grad_h = at::empty_like(h);
-  at::Tensor grad_a_src = at::empty({rows, s.heads}, h.options());
-  at::Tensor grad_a_dst = at::empty({rows, s.heads}, h.options());
-  AT_DISPATCH_FLOATING_TYPES(h.scalar_type(), "graph_attention_backward", [&] {
-    const auto slope = static_cast<scalar_t>(negative_slope);
-    const auto run = [&](auto heads) {
-    backward_rows<scalar_t, decltype(heads)::value>(
-        ptr.data_ptr<int64_t>(), source.data_ptr<int64_t>(), s, grad_.data_ptr<scalar_t>(),
-        h.data_ptr<scalar_t>(), a_src.data_ptr<scalar_t>(), a_dst.data_ptr<scalar_t>(),
-        row_max.data_ptr<scalar_t>(), row_sum.data_ptr<scalar_t>(), slope, edges,
-        grad_a_dst.data_ptr<scalar_t>(), edge_coefficient.data_ptr<scalar_t>(),
-        edge_dz.data_ptr<scalar_t>());
-    backward_columns<scalar_t, decltype(heads)::value>(
-        ptr_t.data_ptr<int64_t>(), target.data_ptr<int64_t>(), edge_t.data_ptr<int64_t>(), s,
-        grad_.data_ptr<scalar_t>(), edge_coefficient.data_ptr<scalar_t>(),
-        edge_dz.data_ptr<scalar_t>(), edges, grad_h.data_ptr<scalar_t>(),
-        grad_a_src.data_ptr<scalar_t>());
-    };
-    with_heads(s.heads, run);
-  });
+  at::Tensor grad_a_src = at::empty({rows, heads}, h.options());
+  at::Tensor grad_a_dst = at::empty({rows, heads}, h.options());
+  int64_t first = 0;
+  for (size_t b = 0; b < ptr.size(); ++b) {
+    const int64_t count = (ptr[b].numel() - 1) * copies[b];
+    const auto part = [&](const at::Tensor& t) { return t.narrow(0, first, count); };
+    const at::Tensor h_b = part(h), a_src_b = part(a_src), a_dst_b = part(a_dst);
+    const Shape s = check_inputs(ptr[b], source[b], copies[b], h_b, a_src_b, a_dst_b, concat);
+    check_graph(ptr_t[b], target[b], "transposed graph");
+    check_graph(ptr_t[b], edge_t[b], "transposed graph's edge numbers");
+    TORCH_CHECK(ptr_t[b].numel() == ptr[b].numel() && target[b].numel() == source[b].numel() &&
+                    edge_t[b].numel() == source[b].numel(),
+                "the transposed graph must have the graph's nodes and edges");
+    const int64_t edges = source[b].numel();
+    at::Tensor edge_coefficient = at::empty({s.copies * edges, s.heads}, h.options());
+    at::Tensor edge_dz = at::empty({s.copies * edges, s.heads}, h.options());
+    const at::Tensor grad_b = part(grad_), row_max_b = part(row_max), row_sum_b = part(row_sum);
+    at::Tensor grad_h_b = part(grad_h), grad_a_src_b = part(grad_a_src),
+               grad_a_dst_b = part(grad_a_dst);
+    AT_DISPATCH_FLOATING_TYPES(h.scalar_type(), "graph_attention_backward", [&] {
+      const auto slope = static_cast<scalar_t>(negative_slope);
+      const auto run = [&](auto heads) {
+        backward_rows<scalar_t, decltype(heads)::value>(
+            ptr[b].data_ptr<int64_t>(), source[b].data_ptr<int64_t>(), s,
+            grad_b.data_ptr<scalar_t>(), h_b.data_ptr<scalar_t>(),
+            a_src_b.data_ptr<scalar_t>(), a_dst_b.data_ptr<scalar_t>(),
+            row_max_b.data_ptr<scalar_t>(), row_sum_b.data_ptr<scalar_t>(), slope, edges,
+            grad_a_dst_b.data_ptr<scalar_t>(), edge_coefficient.data_ptr<scalar_t>(),
+            edge_dz.data_ptr<scalar_t>());
+        backward_columns<scalar_t, decltype(heads)::value>(
+            ptr_t[b].data_ptr<int64_t>(), target[b].data_ptr<int64_t>(),
+            edge_t[b].data_ptr<int64_t>(), s, grad_b.data_ptr<scalar_t>(),
+            edge_coefficient.data_ptr<scalar_t>(), edge_dz.data_ptr<scalar_t>(), edges,
+            grad_h_b.data_ptr<scalar_t>(), grad_a_src_b.data_ptr<scalar_t>());
+      };
+      with_heads(s.heads, run);
+    });
+    first += count;
+  }
   return {grad_h, grad_a_src, grad_a_dst};
 }
 
@@ -506,14 +561,14 @@ std::tuple<at::Tensor, at::Tensor, at::Tensor> graph_attention_backward(
 
 TORCH_LIBRARY(gnngarment, m) {
   m.def(
-      "graph_attention_forward(Tensor ptr, Tensor source, int copies, Tensor h, "
+      "graph_attention_forward(Tensor[] ptr, Tensor[] source, int[] copies, Tensor h, "
       "Tensor a_src, Tensor a_dst, Tensor bias, float negative_slope, bool concat) "
       "-> (Tensor, Tensor, Tensor)");
   m.def(
-      "graph_attention_backward(Tensor ptr, Tensor source, Tensor ptr_t, Tensor target, "
-      "Tensor edge_t, int copies, Tensor grad, Tensor h, Tensor a_src, Tensor a_dst, "
-      "Tensor row_max, "
-      "Tensor row_sum, float negative_slope, bool concat) -> (Tensor, Tensor, Tensor)");
+      "graph_attention_backward(Tensor[] ptr, Tensor[] source, Tensor[] ptr_t, "
+      "Tensor[] target, Tensor[] edge_t, int[] copies, Tensor grad, Tensor h, Tensor a_src, "
+      "Tensor a_dst, Tensor row_max, Tensor row_sum, float negative_slope, bool concat) "
+      "-> (Tensor, Tensor, Tensor)");
 }
 
 TORCH_LIBRARY_IMPL(gnngarment, CPU, m) {
