@@ -36,6 +36,7 @@
 #include <limits>
 #include <tuple>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -451,18 +452,26 @@ int64_t check_blocks(at::TensorList ptr, at::TensorList source, at::IntArrayRef 
   return rows;
 }
 
-std::tuple<at::Tensor, at::Tensor, at::Tensor> graph_attention_forward(
-    at::TensorList ptr, at::TensorList source, at::IntArrayRef copies, const at::Tensor& h,
-    const at::Tensor& a_src, const at::Tensor& a_dst, const at::Tensor& bias,
-    double negative_slope, bool concat) {
-  const int64_t rows = check_blocks(ptr, source, copies, h);
+// (heads, output width) of a call whose graph has `rows` rows, after checking the score
+// matrices against it and h.
+std::pair<int64_t, int64_t> check_scores(const at::Tensor& a_src, const at::Tensor& a_dst,
+                                         const at::Tensor& h, int64_t rows, bool concat) {
   TORCH_CHECK(a_src.dim() == 2 && a_src.size(0) == rows && a_dst.dim() == 2 &&
                   a_dst.size(0) == rows,
               "a_src and a_dst must have the graph's ", rows, " rows");
   const int64_t heads = a_src.size(1);
   TORCH_CHECK(heads > 0 && h.size(1) % heads == 0,
               "h must be a contiguous (N, heads * channels) matrix");
-  const int64_t width = concat ? h.size(1) : h.size(1) / heads;
+  return {heads, concat ? h.size(1) : h.size(1) / heads};
+}
+
+std::tuple<at::Tensor, at::Tensor, at::Tensor> graph_attention_forward(
+    at::TensorList ptr, at::TensorList source, at::IntArrayRef copies, const at::Tensor& h,
+    const at::Tensor& a_src, const at::Tensor& a_dst, const at::Tensor& bias,
+    double negative_slope, bool concat) {
+  const int64_t rows = check_blocks(ptr, source, copies, h);
+  const std::pair<int64_t, int64_t> scores = check_scores(a_src, a_dst, h, rows, concat);
+  const int64_t heads = scores.first, width = scores.second;
   const at::Tensor bias_ = bias.to(h.scalar_type()).contiguous();
   TORCH_CHECK(bias_.numel() == width, "bias must have ", width, " values");
   at::Tensor out = at::empty({rows, width}, h.options());
@@ -500,16 +509,11 @@ std::tuple<at::Tensor, at::Tensor, at::Tensor> graph_attention_backward(
   TORCH_CHECK(ptr_t.size() == ptr.size() && target.size() == ptr.size() &&
                   edge_t.size() == ptr.size(),
               "the transposed graphs must have one entry per block");
-  TORCH_CHECK(a_src.dim() == 2 && a_src.size(0) == rows && a_dst.dim() == 2 &&
-                  a_dst.size(0) == rows,
-              "a_src and a_dst must have the graph's ", rows, " rows");
+  const std::pair<int64_t, int64_t> scores = check_scores(a_src, a_dst, h, rows, concat);
+  const int64_t heads = scores.first, width = scores.second;
   TORCH_CHECK(row_max.sizes() == a_src.sizes() && row_sum.sizes() == a_src.sizes() &&
                   row_max.is_contiguous() && row_sum.is_contiguous(),
               "row_max and row_sum must be contiguous (N, heads), as the forward gave them");
-  const int64_t heads = a_src.size(1);
-  TORCH_CHECK(heads > 0 && h.size(1) % heads == 0,
-              "h must be a contiguous (N, heads * channels) matrix");
-  const int64_t width = concat ? h.size(1) : h.size(1) / heads;
   TORCH_CHECK(grad.dim() == 2 && grad.size(0) == rows && grad.size(1) == width &&
                   grad.scalar_type() == h.scalar_type(),
               "grad must be (N, ", width, ") of h's dtype");
