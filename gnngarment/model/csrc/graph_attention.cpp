@@ -36,7 +36,6 @@
 #include <limits>
 #include <tuple>
 #include <type_traits>
-#include <utility>
 #include <vector>
 
 namespace {
@@ -411,33 +410,19 @@ void check_graph(const at::Tensor& ptr, const at::Tensor& index, const char* wha
               what, ": indices must be a contiguous int64 vector");
 }
 
-Shape check_inputs(const at::Tensor& ptr, const at::Tensor& source, int64_t copies,
-                   const at::Tensor& h, const at::Tensor& a_src, const at::Tensor& a_dst,
-                   bool concat) {
-  check_graph(ptr, source, "graph");
-  TORCH_CHECK(copies >= 0, "copies must be >= 0");
-  const int64_t nodes = ptr.numel() - 1;
-  TORCH_CHECK(a_src.dim() == 2 && a_dst.dim() == 2 && a_src.sizes() == a_dst.sizes(),
-              "a_src and a_dst must both be (N, heads)");
-  TORCH_CHECK(a_src.stride(1) == 1 && a_dst.stride(1) == 1,
-              "a_src and a_dst must have contiguous rows");
-  const int64_t heads = a_src.size(1);
-  TORCH_CHECK(a_src.size(0) == nodes * copies, "a_src has ", a_src.size(0),
-              " rows, the graph ", nodes * copies, " nodes");
-  TORCH_CHECK(heads > 0 && h.dim() == 2 && h.size(0) == nodes * copies &&
-                  h.size(1) % heads == 0 && h.is_contiguous(),
-              "h must be a contiguous (N, heads * channels) matrix");
-  TORCH_CHECK(h.scalar_type() == a_src.scalar_type() && h.scalar_type() == a_dst.scalar_type(),
-              "h, a_src and a_dst must have one dtype");
-  return Shape{nodes, copies, heads, h.size(1) / heads, a_src.stride(0), a_dst.stride(0),
-               concat};
-}
+// What one call's checked inputs give every block: the row count of all blocks together,
+// the heads, the channels per head and the output width.
+struct Call {
+  int64_t rows, heads, channels, width;
+};
 
 // The blocks of a batch: block b is copies[b] copies of the graph (ptr[b], source[b]),
 // its rows following block b - 1's. One call runs them all into one output, so that a
-// batch of several garments needs no concatenation of per-garment results.
-int64_t check_blocks(at::TensorList ptr, at::TensorList source, at::IntArrayRef copies,
-                     const at::Tensor& h) {
+// batch of several garments needs no concatenation of per-garment results. Checks every
+// block's graph and the score and feature matrices against all of them, once.
+Call check_call(at::TensorList ptr, at::TensorList source, at::IntArrayRef copies,
+                const at::Tensor& h, const at::Tensor& a_src, const at::Tensor& a_dst,
+                bool concat) {
   TORCH_CHECK(ptr.size() == source.size() && ptr.size() == copies.size(),
               "ptr, source and copies must have one entry per block");
   int64_t rows = 0;
@@ -446,43 +431,51 @@ int64_t check_blocks(at::TensorList ptr, at::TensorList source, at::IntArrayRef 
     TORCH_CHECK(copies[b] >= 0, "copies must be >= 0");
     rows += (ptr[b].numel() - 1) * copies[b];
   }
-  TORCH_CHECK(h.dim() == 2 && h.size(0) == rows, "the graph has ", rows,
-              " rows (nodes of every copy of every block), h has ",
-              h.dim() == 2 ? h.size(0) : -1);
-  return rows;
+  TORCH_CHECK(a_src.dim() == 2 && a_dst.dim() == 2 && a_src.sizes() == a_dst.sizes(),
+              "a_src and a_dst must both be (N, heads)");
+  TORCH_CHECK(a_src.stride(1) == 1 && a_dst.stride(1) == 1,
+              "a_src and a_dst must have contiguous rows");
+  TORCH_CHECK(a_src.size(0) == rows, "a_src has ", a_src.size(0), " rows, the graph ", rows,
+              " nodes (every copy of every block)");
+  const int64_t heads = a_src.size(1);
+  TORCH_CHECK(heads > 0 && h.dim() == 2 && h.size(0) == rows && h.size(1) % heads == 0 &&
+                  h.is_contiguous(),
+              "h must be a contiguous (N, heads * channels) matrix");
+  TORCH_CHECK(h.scalar_type() == a_src.scalar_type() && h.scalar_type() == a_dst.scalar_type(),
+              "h, a_src and a_dst must have one dtype");
+  const int64_t channels = h.size(1) / heads;
+  return Call{rows, heads, channels, concat ? heads * channels : channels};
 }
 
-// (heads, output width) of a call whose graph has `rows` rows, after checking the score
-// matrices against it and h.
-std::pair<int64_t, int64_t> check_scores(const at::Tensor& a_src, const at::Tensor& a_dst,
-                                         const at::Tensor& h, int64_t rows, bool concat) {
-  TORCH_CHECK(a_src.dim() == 2 && a_src.size(0) == rows && a_dst.dim() == 2 &&
-                  a_dst.size(0) == rows,
-              "a_src and a_dst must have the graph's ", rows, " rows");
-  const int64_t heads = a_src.size(1);
-  TORCH_CHECK(heads > 0 && h.size(1) % heads == 0,
-              "h must be a contiguous (N, heads * channels) matrix");
-  return {heads, concat ? h.size(1) : h.size(1) / heads};
+// Calls run(b, first, count, shape) for each block: its index, its first row and row
+// count in the call's matrices, and its kernels' Shape.
+template <typename Run>
+void for_each_block(at::TensorList ptr, at::IntArrayRef copies, const Call& call,
+                    const at::Tensor& a_src, const at::Tensor& a_dst, bool concat,
+                    const Run& run) {
+  int64_t first = 0;
+  for (size_t b = 0; b < ptr.size(); ++b) {
+    const int64_t nodes = ptr[b].numel() - 1, count = nodes * copies[b];
+    run(b, first, count, Shape{nodes, copies[b], call.heads, call.channels, a_src.stride(0),
+                               a_dst.stride(0), concat});
+    first += count;
+  }
 }
 
 std::tuple<at::Tensor, at::Tensor, at::Tensor> graph_attention_forward(
     at::TensorList ptr, at::TensorList source, at::IntArrayRef copies, const at::Tensor& h,
     const at::Tensor& a_src, const at::Tensor& a_dst, const at::Tensor& bias,
     double negative_slope, bool concat) {
-  const int64_t rows = check_blocks(ptr, source, copies, h);
-  const std::pair<int64_t, int64_t> scores = check_scores(a_src, a_dst, h, rows, concat);
-  const int64_t heads = scores.first, width = scores.second;
+  const Call call = check_call(ptr, source, copies, h, a_src, a_dst, concat);
   const at::Tensor bias_ = bias.to(h.scalar_type()).contiguous();
-  TORCH_CHECK(bias_.numel() == width, "bias must have ", width, " values");
-  at::Tensor out = at::empty({rows, width}, h.options());
-  at::Tensor row_max = at::empty({rows, heads}, h.options());
-  at::Tensor row_sum = at::empty({rows, heads}, h.options());
-  int64_t first = 0;
-  for (size_t b = 0; b < ptr.size(); ++b) {
-    const int64_t count = (ptr[b].numel() - 1) * copies[b];
+  TORCH_CHECK(bias_.numel() == call.width, "bias must have ", call.width, " values");
+  at::Tensor out = at::empty({call.rows, call.width}, h.options());
+  at::Tensor row_max = at::empty({call.rows, call.heads}, h.options());
+  at::Tensor row_sum = at::empty({call.rows, call.heads}, h.options());
+  for_each_block(ptr, copies, call, a_src, a_dst, concat,
+                 [&](size_t b, int64_t first, int64_t count, const Shape& s) {
     const auto part = [&](const at::Tensor& t) { return t.narrow(0, first, count); };
     const at::Tensor h_b = part(h), a_src_b = part(a_src), a_dst_b = part(a_dst);
-    const Shape s = check_inputs(ptr[b], source[b], copies[b], h_b, a_src_b, a_dst_b, concat);
     at::Tensor out_b = part(out), row_max_b = part(row_max), row_sum_b = part(row_sum);
     AT_DISPATCH_FLOATING_TYPES(h.scalar_type(), "graph_attention_forward", [&] {
       const auto run = [&](auto heads) {
@@ -495,8 +488,7 @@ std::tuple<at::Tensor, at::Tensor, at::Tensor> graph_attention_forward(
       };
       with_heads(s.heads, run);
     });
-    first += count;
-  }
+  });
   return {out, row_max, row_sum};
 }
 
@@ -505,33 +497,29 @@ std::tuple<at::Tensor, at::Tensor, at::Tensor> graph_attention_backward(
     at::TensorList edge_t, at::IntArrayRef copies, const at::Tensor& grad, const at::Tensor& h,
     const at::Tensor& a_src, const at::Tensor& a_dst, const at::Tensor& row_max,
     const at::Tensor& row_sum, double negative_slope, bool concat) {
-  const int64_t rows = check_blocks(ptr, source, copies, h);
+  const Call call = check_call(ptr, source, copies, h, a_src, a_dst, concat);
   TORCH_CHECK(ptr_t.size() == ptr.size() && target.size() == ptr.size() &&
                   edge_t.size() == ptr.size(),
               "the transposed graphs must have one entry per block");
-  const std::pair<int64_t, int64_t> scores = check_scores(a_src, a_dst, h, rows, concat);
-  const int64_t heads = scores.first, width = scores.second;
   TORCH_CHECK(row_max.sizes() == a_src.sizes() && row_sum.sizes() == a_src.sizes() &&
                   row_max.is_contiguous() && row_sum.is_contiguous(),
               "row_max and row_sum must be contiguous (N, heads), as the forward gave them");
-  TORCH_CHECK(grad.dim() == 2 && grad.size(0) == rows && grad.size(1) == width &&
+  TORCH_CHECK(grad.dim() == 2 && grad.size(0) == call.rows && grad.size(1) == call.width &&
                   grad.scalar_type() == h.scalar_type(),
-              "grad must be (N, ", width, ") of h's dtype");
+              "grad must be (N, ", call.width, ") of h's dtype");
   const at::Tensor grad_ = grad.contiguous();
   at::Tensor grad_h = at::empty_like(h);
-  at::Tensor grad_a_src = at::empty({rows, heads}, h.options());
-  at::Tensor grad_a_dst = at::empty({rows, heads}, h.options());
-  int64_t first = 0;
-  for (size_t b = 0; b < ptr.size(); ++b) {
-    const int64_t count = (ptr[b].numel() - 1) * copies[b];
-    const auto part = [&](const at::Tensor& t) { return t.narrow(0, first, count); };
-    const at::Tensor h_b = part(h), a_src_b = part(a_src), a_dst_b = part(a_dst);
-    const Shape s = check_inputs(ptr[b], source[b], copies[b], h_b, a_src_b, a_dst_b, concat);
+  at::Tensor grad_a_src = at::empty({call.rows, call.heads}, h.options());
+  at::Tensor grad_a_dst = at::empty({call.rows, call.heads}, h.options());
+  for_each_block(ptr, copies, call, a_src, a_dst, concat,
+                 [&](size_t b, int64_t first, int64_t count, const Shape& s) {
     check_graph(ptr_t[b], target[b], "transposed graph");
     check_graph(ptr_t[b], edge_t[b], "transposed graph's edge numbers");
     TORCH_CHECK(ptr_t[b].numel() == ptr[b].numel() && target[b].numel() == source[b].numel() &&
                     edge_t[b].numel() == source[b].numel(),
                 "the transposed graph must have the graph's nodes and edges");
+    const auto part = [&](const at::Tensor& t) { return t.narrow(0, first, count); };
+    const at::Tensor h_b = part(h), a_src_b = part(a_src), a_dst_b = part(a_dst);
     const int64_t edges = source[b].numel();
     at::Tensor edge_coefficient = at::empty({s.copies * edges, s.heads}, h.options());
     at::Tensor edge_dz = at::empty({s.copies * edges, s.heads}, h.options());
@@ -556,8 +544,7 @@ std::tuple<at::Tensor, at::Tensor, at::Tensor> graph_attention_backward(
       };
       with_heads(s.heads, run);
     });
-    first += count;
-  }
+  });
   return {grad_h, grad_a_src, grad_a_dst};
 }
 
