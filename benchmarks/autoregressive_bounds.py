@@ -73,13 +73,15 @@ from contact_bounds import (  # noqa: E402
     regressor_inputs,
 )
 from dynamics_bounds import Sequence, blended_frames  # noqa: E402
-from motion_count_bounds import chosen_windows, simulated_split, window_plans  # noqa: E402
+from motion_count_bounds import (  # noqa: E402
+    add_window_arguments,
+    draped_window_plans,
+    simulated_split,
+)
 from skinning_bounds import fit_weights, vertex_error_mm  # noqa: E402
 
 from benchmarks.machine import cpu_model  # noqa: E402
 from data_prep.bodies import anny_body_model  # noqa: E402
-from data_prep.config import DataConfig  # noqa: E402
-from gnngarment.config import load_config  # noqa: E402
 from gnngarment.data.cache import read_garment  # noqa: E402
 from gnngarment.geometry.graph import adjacency_matrix, edge_index_from_faces  # noqa: E402
 
@@ -220,12 +222,12 @@ def per_frame_prediction(network: nn.Module, item: dict, mean: torch.Tensor,
     return item["skinned"] + np.einsum("tnab,tnb->tna", item["frames"], offsets)
 
 
-def fit_and_score(train: Garment, test: Garment, inputs: str, noise: float, epochs: int,
-                  samples: int, seed: int) -> list[float]:
-    """Fit the MLP of ``inputs`` on ``train``; mean E_verts (mm) over ``test``'s sequences
-    after each epoch (rolled out where the inputs hold the state)."""
+def fit_and_score(train: Garment, rows: dict[str, torch.Tensor], test: Garment, inputs: str,
+                  noise: float, epochs: int, samples: int, seed: int) -> list[float]:
+    """Fit the MLP of ``inputs`` on ``train``'s :func:`training_rows` ``rows``; mean
+    E_verts (mm) over ``test``'s sequences after each epoch (rolled out where the inputs
+    hold the state)."""
     generator = torch.Generator().manual_seed(seed)
-    rows = training_rows(train, inputs)
     stateful = inputs != "per-frame"
     if stateful:
         clean = [rows["static"], state_features(rows["previous"], rows["before"],
@@ -280,12 +282,7 @@ def fit_and_score(train: Garment, test: Garment, inputs: str, noise: float, epoc
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--config", type=Path,
-                        default=ROOT / "configs/data/benchmark_cmu.yaml")
-    parser.add_argument("--work", type=Path, default=ROOT / "runs/simulation_spread")
-    parser.add_argument("--train-windows", type=int, default=16)
-    parser.add_argument("--test-windows", type=int, default=6)
-    parser.add_argument("--types", nargs="+", default=None, help="garment types (default all)")
+    add_window_arguments(parser)
     parser.add_argument("--inputs", nargs="+", default=list(INPUTS), choices=INPUTS)
     parser.add_argument("--noise", type=float, nargs="+", default=[1.0, 3.0],
                         help="training noise (mm) on the state inputs; each is fitted")
@@ -294,16 +291,7 @@ def main() -> None:
                         help="training rows (vertex-frames) drawn per epoch")
     args = parser.parse_args()
     torch.set_num_threads(1)
-    config = load_config(args.config, DataConfig)
-    train_windows, test_windows = chosen_windows(config, args.train_windows, args.test_windows)
-    designs, plans = window_plans(config, train_windows + test_windows, args.types)
-    if not designs:
-        sys.exit(f"error: {args.config}: no test design of types {args.types}")
-    missing = [d.garment for d in designs
-               if not (args.work / "garments" / f"{d.garment}.npz").is_file()]
-    if missing:
-        sys.exit(f"error: {args.work}: no drapes of {', '.join(missing)} "
-                 "(run motion_count_bounds.py with the same --work first)")
+    config, train_windows, test_windows, designs, plans = draped_window_plans(args)
     print(f"{len(designs)} designs × ({len(train_windows)} training-subject + "
           f"{len(test_windows)} test-subject CMU windows) of {args.config.name}; "
           f"{cpu_model()}, load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores; "
@@ -341,9 +329,10 @@ def main() -> None:
                                          for s in tests]))}
         for inputs in args.inputs:
             best = np.inf
+            training = training_rows(train_arrays, inputs)  # shared by every noise level
             for noise in ([0.0] if inputs == "per-frame" else args.noise):
-                curve = fit_and_score(train_arrays, test_arrays, inputs, noise, args.epochs,
-                                      args.samples, seed=0)
+                curve = fit_and_score(train_arrays, training, test_arrays, inputs, noise,
+                                      args.epochs, args.samples, seed=0)
                 best = min(best, min(curve))
                 print(f"  {garment_name} {inputs} noise {noise:g} mm: per epoch "
                       + " ".join(f"{e:.2f}" for e in curve), file=sys.stderr, flush=True)

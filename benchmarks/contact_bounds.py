@@ -57,10 +57,10 @@ for path in (ROOT, ROOT / "benchmarks"):
 
 from dynamics_bounds import Sequence, blended_frames, pose_features  # noqa: E402
 from motion_count_bounds import (  # noqa: E402
-    chosen_windows,
+    add_window_arguments,
+    draped_window_plans,
     simulate_all,
     simulated_split,
-    window_plans,
 )
 from skinning_bounds import fit_weights, vertex_error_mm  # noqa: E402
 
@@ -68,7 +68,6 @@ from benchmarks.machine import cpu_model  # noqa: E402
 from data_prep.bodies import anny_body_model, anny_shape  # noqa: E402
 from data_prep.config import DataConfig  # noqa: E402
 from data_prep.plan import SequencePlan, planned_motion  # noqa: E402
-from gnngarment.config import load_config  # noqa: E402
 
 #: The input sets the regressor is fitted from, in table order.
 INPUTS = ("motion", "contact", "motion+contact")
@@ -176,12 +175,7 @@ def fit_and_score(train: list[np.ndarray], residuals: list[np.ndarray],
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--config", type=Path,
-                        default=ROOT / "configs/data/benchmark_cmu.yaml")
-    parser.add_argument("--work", type=Path, default=ROOT / "runs/simulation_spread")
-    parser.add_argument("--train-windows", type=int, default=16)
-    parser.add_argument("--test-windows", type=int, default=6)
-    parser.add_argument("--types", nargs="+", default=None, help="garment types (default all)")
+    add_window_arguments(parser)
     parser.add_argument("--inputs", nargs="+", default=list(INPUTS), choices=INPUTS)
     parser.add_argument("--epochs", type=int, default=8)
     parser.add_argument("--samples", type=int, default=1_000_000,
@@ -190,16 +184,7 @@ def main() -> None:
                         help="simulation processes, for sequences not yet simulated")
     args = parser.parse_args()
     torch.set_num_threads(1)
-    config = load_config(args.config, DataConfig)
-    train_windows, test_windows = chosen_windows(config, args.train_windows, args.test_windows)
-    designs, plans = window_plans(config, train_windows + test_windows, args.types)
-    if not designs:
-        sys.exit(f"error: {args.config}: no test design of types {args.types}")
-    missing = [d.garment for d in designs
-               if not (args.work / "garments" / f"{d.garment}.npz").is_file()]
-    if missing:
-        sys.exit(f"error: {args.work}: no drapes of {', '.join(missing)} "
-                 "(run motion_count_bounds.py with the same --work first)")
+    config, train_windows, test_windows, designs, plans = draped_window_plans(args)
     print(f"{len(designs)} designs × ({len(train_windows)} training-subject + "
           f"{len(test_windows)} test-subject CMU windows) of {args.config.name}; "
           f"{cpu_model()}, load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores; "

@@ -151,6 +151,36 @@ def window_plans(config: DataConfig, windows: list[MotionPlan], types: list[str]
     return designs, plans
 
 
+def add_window_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options that choose the garments and windows, shared by the bounds that run
+    on this script's simulations (``contact_bounds``, ``autoregressive_bounds``)."""
+    parser.add_argument("--config", type=Path,
+                        default=ROOT / "configs/data/benchmark_cmu.yaml")
+    parser.add_argument("--work", type=Path, default=ROOT / "runs/simulation_spread")
+    parser.add_argument("--train-windows", type=int, default=16)
+    parser.add_argument("--test-windows", type=int, default=6)
+    parser.add_argument("--types", nargs="+", default=None, help="garment types (default all)")
+
+
+def draped_window_plans(args: argparse.Namespace) -> tuple[
+        DataConfig, list[MotionPlan], list[MotionPlan], list[SequencePlan],
+        dict[str, list[SequencePlan]]]:
+    """``(config, training windows, test windows, designs, plans)`` of
+    :func:`add_window_arguments`' options, for a bound that reads drapes this script made
+    in ``--work``: exits with the reason when there is no design or a drape is missing."""
+    config = load_config(args.config, DataConfig)
+    train_windows, test_windows = chosen_windows(config, args.train_windows, args.test_windows)
+    designs, plans = window_plans(config, train_windows + test_windows, args.types)
+    if not designs:
+        sys.exit(f"error: {args.config}: no test design of types {args.types}")
+    missing = [d.garment for d in designs
+               if not (args.work / "garments" / f"{d.garment}.npz").is_file()]
+    if missing:
+        sys.exit(f"error: {args.work}: no drapes of {', '.join(missing)} "
+                 "(run motion_count_bounds.py with the same --work first)")
+    return config, train_windows, test_windows, designs, plans
+
+
 def _saved(work: Path, plan: SequencePlan) -> Path:
     return work / "motion_count" / f"{plan.name}.npz"
 
@@ -283,16 +313,11 @@ def garment_curve(train: list[Sequence], test: list[Sequence], counts: list[int]
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--config", type=Path,
-                        default=ROOT / "configs/data/benchmark_cmu.yaml")
-    parser.add_argument("--work", type=Path, default=ROOT / "runs/simulation_spread")
-    parser.add_argument("--train-windows", type=int, default=16)
-    parser.add_argument("--test-windows", type=int, default=6)
+    add_window_arguments(parser)
     parser.add_argument("--counts", type=int, nargs="+", default=[1, 2, 4, 8, 16])
     parser.add_argument("--draws", type=int, default=3,
                         help="random training subsets per count (one when it is all of them)")
     parser.add_argument("--ridges", type=float, nargs="+", default=[1.0, 100.0, 10000.0])
-    parser.add_argument("--types", nargs="+", default=None, help="garment types (default all)")
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--no-model", action="store_true", help="skip the shipped model's row")
     parser.add_argument("--responses", nargs="+", default=list(RESPONSES), choices=RESPONSES,
